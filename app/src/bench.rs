@@ -1,0 +1,71 @@
+//! `tracelab bench`: closest-hit throughput for one primary ray per pixel, as
+//! `../shared/perf/embree_bench.cpp` measures Embree (same rays, same checksums).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use tracelab_core::accel::TriangleBvh;
+use tracelab_core::{CompiledScene, Mesh, MeshSlot, NodeKind};
+
+use crate::cli::{BenchArgs, CliError, load};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+pub fn run(b: &BenchArgs) -> Result<(), CliError> {
+    let (w, h) = (b.size[0], b.size[1]);
+    let scene = load(Some(&b.scene))?;
+
+    // Distinct meshes (shared by path), to time their BVH builds on their own.
+    let mut meshes: Vec<Arc<Mesh>> = Vec::new();
+    for (_, n) in scene.graph.iter() {
+        if let NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(m), .. } = &n.kind {
+            if !meshes.iter().any(|x| Arc::ptr_eq(x, m)) {
+                meshes.push(m.clone());
+            }
+        }
+    }
+    let t_build = Instant::now();
+    for m in &meshes {
+        std::hint::black_box(TriangleBvh::build(&m.positions, &m.triangles));
+    }
+    let compiled = CompiledScene::new(&scene);
+    let build_ms = t_build.elapsed().as_secs_f64() * 1e3;
+
+    let tris: usize = meshes.iter().map(|m| m.triangle_count()).sum();
+    let bytes: usize = meshes.iter().map(|m| m.memory_bytes()).sum();
+    if tris > 0 {
+        println!(
+            "mesh: {tris} triangles, {bytes} bytes for geometry + BVH ({:.1} bytes/triangle)",
+            bytes as f64 / tris as f64
+        );
+    }
+
+    let t_min = compiled.camera.t_min();
+    let mut buf = vec![f32::INFINITY; w as usize * h as usize];
+    let frame = |buf: &mut Vec<f32>| {
+        buf.par_chunks_mut(w as usize).enumerate().for_each(|(row, out)| {
+            for (x, t) in out.iter_mut().enumerate() {
+                let ray = compiled.camera.pixel_ray(x as u32, row as u32, w, h);
+                *t = compiled.intersect(&ray, t_min, f32::INFINITY).map_or(f32::INFINITY, |hit| hit.t);
+            }
+        });
+    };
+    frame(&mut buf); // warm-up
+    let mut times = Vec::with_capacity(b.repeat);
+    for _ in 0..b.repeat.max(1) {
+        let t = Instant::now();
+        frame(&mut buf);
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let secs = median(times);
+    let hits = buf.iter().filter(|t| t.is_finite()).count();
+    let sum_t: f64 = buf.iter().filter(|t| t.is_finite()).map(|&t| t as f64).sum();
+    let mrays = (w as f64 * h as f64) / secs / 1e6;
+    println!("frame: {w}x{h}, {} threads, median {:.3} ms of {}", rayon::current_num_threads(), secs * 1e3, b.repeat.max(1));
+    println!("BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}");
+    Ok(())
+}

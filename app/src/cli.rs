@@ -1,0 +1,391 @@
+//! The command line: modern subcommands (clap) and the course's own `raytracer` flags.
+//!
+//! Exit codes: 0 success, 1 scene or I/O error, 2 usage error.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use clap::{Parser, Subcommand, ValueEnum};
+use tracelab_core::render::{SharedFrame, render_full};
+use tracelab_core::{CompiledScene, MeshCache, NormalTransform, RenderSettings, Scene, View};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "tracelab",
+    version,
+    about = "Scene viewer, editor and ray tracer for MIT 6.837 scene files",
+    long_about = "Scene viewer, editor and ray tracer for MIT 6.837 scene files.\n\n\
+        With no arguments, opens the editor on a built-in scene; with a SCENE, opens that file.\n\
+        The course's own command lines work unchanged, e.g.\n  \
+        tracelab -input scene2_05_inside_sphere.txt -size 200 200 -output out.tga \\\n    \
+        -depth 9 11 depth.tga -normals normals.tga -shade_back",
+    args_conflicts_with_subcommands = true
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Scene file to open in the editor.
+    pub scene: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
+    Render(RenderArgs),
+    /// Rewrite a scene file in canonical form.
+    Fmt {
+        scene: PathBuf,
+        /// Where to write (default: standard output).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Time closest-hit queries for one primary ray per pixel (see ../shared/perf).
+    Bench(BenchArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (default: the built-in scene).
+    pub scene: Option<PathBuf>,
+    /// Image size in pixels.
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [400u32, 400])]
+    pub size: Vec<u32>,
+    /// Colour image.
+    #[arg(long, short)]
+    pub output: Option<PathBuf>,
+    /// Normal image: |n| of the world normal as RGB.
+    #[arg(long)]
+    pub normals: Option<PathBuf>,
+    /// Depth image: t in [MIN, MAX] mapped to white..black.
+    #[arg(long, num_args = 3, value_names = ["MIN", "MAX", "FILE"])]
+    pub depth: Option<Vec<String>>,
+    /// Shade back-facing surfaces with the flipped normal instead of black.
+    #[arg(long)]
+    pub shade_back: bool,
+    /// How normals go through Transforms.
+    #[arg(long, value_enum, default_value_t = NormalMode::Correct)]
+    pub normal_transform: NormalMode,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    pub scene: PathBuf,
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800])]
+    pub size: Vec<u32>,
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalMode {
+    /// (M⁻¹)ᵀ n: perpendicular to the surface under any transform.
+    Correct,
+    /// M n: the lecture's incorrect transformation, for comparison.
+    Incorrect,
+}
+
+impl From<NormalMode> for NormalTransform {
+    fn from(m: NormalMode) -> Self {
+        match m {
+            NormalMode::Correct => NormalTransform::Correct,
+            NormalMode::Incorrect => NormalTransform::Incorrect,
+        }
+    }
+}
+
+/// A request to render, however it was spelled on the command line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderJob {
+    pub scene: Option<PathBuf>,
+    pub width: u32,
+    pub height: u32,
+    pub output: Option<PathBuf>,
+    pub normals: Option<PathBuf>,
+    pub depth: Option<(f32, f32, PathBuf)>,
+    pub shade_back: bool,
+    pub normal_transform: NormalTransform,
+}
+
+/// An error with the exit code it maps to.
+#[derive(Debug)]
+pub enum CliError {
+    Usage(String),
+    Failed(String),
+}
+
+impl CliError {
+    fn code(&self) -> ExitCode {
+        match self {
+            CliError::Usage(_) => ExitCode::from(2),
+            CliError::Failed(_) => ExitCode::from(1),
+        }
+    }
+}
+
+pub fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().collect();
+    let result = run(&args);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            match &e {
+                CliError::Usage(m) => eprintln!("tracelab: {m}\nTry 'tracelab --help'."),
+                CliError::Failed(m) => eprint!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }),
+            }
+            e.code()
+        }
+    }
+}
+
+pub fn run(args: &[String]) -> Result<(), CliError> {
+    // The course's raytracer flags start with a single dash: `-input`, `-size`, ...
+    if args.iter().skip(1).any(|a| a == "-input") {
+        let job = parse_course_args(&args[1..])?;
+        return run_render(&job);
+    }
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            // --help and --version print and succeed; real usage errors exit 2.
+            let _ = e.print();
+            return match e.kind() {
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => Ok(()),
+                _ => Err(CliError::Usage(String::new())).map_err(|_| CliError::Usage("invalid arguments".into())),
+            };
+        }
+    };
+    match cli.command {
+        Some(Command::Render(r)) => run_render(&render_job(r)?),
+        Some(Command::Fmt { scene, output }) => run_fmt(&scene, output.as_deref()),
+        Some(Command::Bench(b)) => run_bench(&b),
+        None => run_gui(cli.scene),
+    }
+}
+
+fn run_gui(scene: Option<PathBuf>) -> Result<(), CliError> {
+    // The editor lands with the GUI issue; until then, say so instead of doing nothing.
+    let _ = scene;
+    Err(CliError::Usage(
+        "the editor is not built yet; use 'tracelab render SCENE --output out.png' (see --help)".into(),
+    ))
+}
+
+fn render_job(r: RenderArgs) -> Result<RenderJob, CliError> {
+    let depth = match r.depth {
+        None => None,
+        Some(v) => {
+            let min = parse_f32(&v[0], "--depth MIN")?;
+            let max = parse_f32(&v[1], "--depth MAX")?;
+            Some((min, max, PathBuf::from(&v[2])))
+        }
+    };
+    let job = RenderJob {
+        scene: r.scene,
+        width: r.size[0],
+        height: r.size[1],
+        output: r.output,
+        normals: r.normals,
+        depth,
+        shade_back: r.shade_back,
+        normal_transform: r.normal_transform.into(),
+    };
+    if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
+        return Err(CliError::Usage("nothing to write: give --output, --normals or --depth".into()));
+    }
+    Ok(job)
+}
+
+fn parse_f32(s: &str, what: &str) -> Result<f32, CliError> {
+    s.parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| CliError::Usage(format!("{what}: expected a number, found \"{s}\"")))
+}
+
+fn parse_u32(s: &str, what: &str) -> Result<u32, CliError> {
+    s.parse::<u32>()
+        .ok()
+        .filter(|&v| v > 0)
+        .ok_or_else(|| CliError::Usage(format!("{what}: expected a positive whole number, found \"{s}\"")))
+}
+
+/// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
+/// -shade_back`, plus tracelab's `-normal_transform correct|incorrect`.
+pub fn parse_course_args(args: &[String]) -> Result<RenderJob, CliError> {
+    let mut job = RenderJob {
+        scene: None,
+        width: 0,
+        height: 0,
+        output: None,
+        normals: None,
+        depth: None,
+        shade_back: false,
+        normal_transform: NormalTransform::Correct,
+    };
+    let mut it = args.iter();
+    let take = |it: &mut std::slice::Iter<String>, flag: &str| -> Result<String, CliError> {
+        it.next().cloned().ok_or_else(|| CliError::Usage(format!("{flag} needs a value")))
+    };
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "-input" => job.scene = Some(PathBuf::from(take(&mut it, a)?)),
+            "-size" => {
+                job.width = parse_u32(&take(&mut it, a)?, "-size width")?;
+                job.height = parse_u32(&take(&mut it, a)?, "-size height")?;
+            }
+            "-output" => job.output = Some(PathBuf::from(take(&mut it, a)?)),
+            "-normals" => job.normals = Some(PathBuf::from(take(&mut it, a)?)),
+            "-depth" => {
+                let min = parse_f32(&take(&mut it, a)?, "-depth min")?;
+                let max = parse_f32(&take(&mut it, a)?, "-depth max")?;
+                job.depth = Some((min, max, PathBuf::from(take(&mut it, a)?)));
+            }
+            "-shade_back" => job.shade_back = true,
+            "-normal_transform" => {
+                job.normal_transform = match take(&mut it, a)?.as_str() {
+                    "correct" => NormalTransform::Correct,
+                    "incorrect" => NormalTransform::Incorrect,
+                    other => return Err(CliError::Usage(format!("-normal_transform: expected correct or incorrect, found \"{other}\""))),
+                }
+            }
+            other => return Err(CliError::Usage(format!("unknown option \"{other}\" (course flags: -input -size -output -normals -depth -shade_back)"))),
+        }
+    }
+    if job.scene.is_none() {
+        return Err(CliError::Usage("-input needs a scene file".into()));
+    }
+    if job.width == 0 {
+        return Err(CliError::Usage("-size W H is required".into()));
+    }
+    Ok(job)
+}
+
+/// Reads a scene, printing warnings; errors come back as one message.
+pub fn load(path: Option<&Path>) -> Result<Scene, CliError> {
+    let mut cache = MeshCache::new();
+    let outcome = match path {
+        Some(p) => tracelab_core::load_scene(p, &mut cache),
+        None => tracelab_core::parse_scene(crate::DEFAULT_SCENE.as_bytes(), crate::DEFAULT_SCENE_NAME, None, &mut cache),
+    };
+    match outcome.into_result() {
+        Ok((scene, warnings)) => {
+            for w in warnings.warnings() {
+                eprintln!("{w}");
+            }
+            Ok(scene)
+        }
+        Err(diags) => Err(CliError::Failed(diags.to_string())),
+    }
+}
+
+fn check_extension(path: &Path) -> Result<(), CliError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png" | "tga" | "ppm" | "pnm" | "bmp") => Ok(()),
+        _ => Err(CliError::Usage(format!(
+            "{}: unknown image format (use .png, .tga, .ppm or .bmp)",
+            path.display()
+        ))),
+    }
+}
+
+pub fn run_render(job: &RenderJob) -> Result<(), CliError> {
+    for p in [&job.output, &job.normals].into_iter().flatten().chain(job.depth.as_ref().map(|d| &d.2)) {
+        check_extension(p)?;
+    }
+    let scene = load(job.scene.as_deref())?;
+    let compiled = CompiledScene::new(&scene);
+    let settings = RenderSettings {
+        width: job.width,
+        height: job.height,
+        shade_back: job.shade_back,
+        normal_transform: job.normal_transform,
+    };
+    let frame = render_with_progress(&compiled, &settings);
+    let save = |view: View, depth: (f32, f32), path: &Path| {
+        frame
+            .save(view, depth, path)
+            .map_err(|e| CliError::Failed(format!("{}: cannot write image: {e}", path.display())))
+    };
+    if let Some(p) = &job.output {
+        save(View::Color, (0.0, 1.0), p)?;
+    }
+    if let Some(p) = &job.normals {
+        save(View::Normals, (0.0, 1.0), p)?;
+    }
+    if let Some((min, max, p)) = &job.depth {
+        save(View::Depth, (*min, *max), p)?;
+    }
+    Ok(())
+}
+
+/// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
+fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
+    let target = Arc::new(SharedFrame::new());
+    let done = Arc::new(AtomicBool::new(false));
+    let watcher = std::io::stderr().is_terminal().then(|| {
+        let (target, done) = (target.clone(), done.clone());
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            let mut shown = false;
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(100));
+                if start.elapsed() > Duration::from_secs(1) {
+                    let p = target.progress();
+                    let bar = (p * 30.0) as usize;
+                    eprint!("\rrendering [{}{}] {:3.0}%", "#".repeat(bar), " ".repeat(30 - bar.min(30)), p * 100.0);
+                    shown = true;
+                }
+            }
+            if shown {
+                eprintln!("\rrendering [{}] 100%", "#".repeat(30));
+            }
+        })
+    });
+    let never = AtomicBool::new(false);
+    let _ = render_full(scene, settings, &target, &never);
+    done.store(true, Ordering::Relaxed);
+    if let Some(w) = watcher {
+        let _ = w.join();
+    }
+    std::mem::replace(&mut *target.lock(), tracelab_core::Frame::new(0, 0))
+}
+
+fn run_fmt(scene: &Path, output: Option<&Path>) -> Result<(), CliError> {
+    let s = load(Some(scene))?;
+    let text = tracelab_core::write_scene(&s);
+    match output {
+        None => {
+            print!("{text}");
+            Ok(())
+        }
+        Some(out) => write_atomic(out, text.as_bytes())
+            .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", out.display()))),
+    }
+}
+
+/// Writes via a temporary file in the same folder and a rename, so a failure never leaves a
+/// half-written file behind.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tracelab-tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
+}
+
+fn run_bench(b: &BenchArgs) -> Result<(), CliError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(b.threads.max(1))
+        .build()
+        .map_err(|e| CliError::Failed(format!("cannot start threads: {e}")))?;
+    pool.install(|| crate::bench::run(b))
+}

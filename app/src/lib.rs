@@ -1,0 +1,8 @@
+//! tracelab the application: command line and desktop editor over `tracelab-core`.
+
+pub mod cli;
+
+/// The scene tracelab opens when started with no file.
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.txt");
+pub const DEFAULT_SCENE_NAME: &str = "default.txt (built in)";
+pub mod bench;

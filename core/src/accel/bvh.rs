@@ -1,0 +1,330 @@
+//! A binary BVH built with binned SAH, flattened depth-first into 32-byte nodes. It knows
+//! only boxes; callers intersect their primitives in a leaf closure.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::geometry::Aabb;
+
+const BINS: usize = 16;
+const MAX_LEAF: usize = 4;
+/// Below this many primitives a subtree is built on the current thread.
+const PARALLEL_THRESHOLD: usize = 4096;
+
+/// Leaf when `count > 0` (primitives `first..first+count` of `Bvh::indices`); otherwise an
+/// interior node whose left child is the next node and right child is `right_or_first`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct BvhNode {
+    pub min: [f32; 3],
+    pub right_or_first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+impl BvhNode {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(Vec3::from(self.min), Vec3::from(self.max))
+    }
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Bvh {
+    pub nodes: Vec<BvhNode>,
+    /// Primitive ids in leaf order.
+    pub indices: Vec<u32>,
+}
+
+enum Tmp {
+    Leaf { bounds: Aabb, first: usize, count: usize },
+    Inner { bounds: Aabb, left: Box<Tmp>, right: Box<Tmp>, size: usize },
+}
+
+impl Tmp {
+    fn size(&self) -> usize {
+        match self {
+            Tmp::Leaf { .. } => 1,
+            Tmp::Inner { size, .. } => *size,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Prim {
+    bounds: Aabb,
+    centroid: Vec3,
+    id: u32,
+}
+
+impl Bvh {
+    /// Builds over `bounds` (one box per primitive; id = position in the slice).
+    pub fn build(bounds: &[Aabb]) -> Bvh {
+        if bounds.is_empty() {
+            return Bvh::default();
+        }
+        let mut prims: Vec<Prim> = bounds
+            .par_iter()
+            .enumerate()
+            .map(|(i, b)| Prim { bounds: *b, centroid: b.center(), id: i as u32 })
+            .collect();
+        let root = build_rec(&mut prims, 0);
+        let mut nodes = Vec::with_capacity(root.size());
+        flatten(root, &mut nodes);
+        let indices = prims.iter().map(|p| p.id).collect();
+        Bvh { nodes, indices }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map(|n| n.bounds()).unwrap_or(Aabb::EMPTY)
+    }
+
+    /// Closest-hit traversal, near child first. `leaf(prim_id, t_max)` returns a closer t if
+    /// that primitive is hit before `t_max`.
+    #[inline]
+    pub fn traverse(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        mut t_max: f32,
+        mut leaf: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        let inv = dir.recip();
+        let mut stack = [0u32; 64];
+        let mut sp = 0usize;
+        let mut idx = 0u32;
+        if self.nodes[0].bounds().hit(origin, inv, t_min, t_max).is_none() {
+            return t_max;
+        }
+        loop {
+            let node = &self.nodes[idx as usize];
+            if node.is_leaf() {
+                let first = node.right_or_first as usize;
+                for &p in &self.indices[first..first + node.count as usize] {
+                    if let Some(t) = leaf(p, t_max) {
+                        t_max = t;
+                    }
+                }
+            } else {
+                let l = idx + 1;
+                let r = node.right_or_first;
+                let tl = self.nodes[l as usize].bounds().hit(origin, inv, t_min, t_max);
+                let tr = self.nodes[r as usize].bounds().hit(origin, inv, t_min, t_max);
+                match (tl, tr) {
+                    (Some(a), Some(b)) => {
+                        let (near, far) = if a <= b { (l, r) } else { (r, l) };
+                        if sp < stack.len() {
+                            stack[sp] = far;
+                            sp += 1;
+                        }
+                        idx = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        idx = l;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        idx = r;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // Pop, skipping nodes the shrinking t_max has ruled out.
+            loop {
+                if sp == 0 {
+                    return t_max;
+                }
+                sp -= 1;
+                let n = stack[sp];
+                if self.nodes[n as usize].bounds().hit(origin, inv, t_min, t_max).is_some() {
+                    idx = n;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Checks the structural invariants: every primitive in exactly one leaf, children inside
+    /// their parents' bounds, leaves holding the boxes of their primitives. For tests.
+    pub fn check_invariants(&self, bounds: &[Aabb]) -> Result<(), String> {
+        if bounds.is_empty() {
+            return if self.nodes.is_empty() { Ok(()) } else { Err("nodes for no primitives".into()) };
+        }
+        let mut seen = vec![0u32; bounds.len()];
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = self.nodes.get(i).ok_or(format!("node {i} out of range"))?;
+            let nb = n.bounds();
+            if n.is_leaf() {
+                let first = n.right_or_first as usize;
+                let ids = self
+                    .indices
+                    .get(first..first + n.count as usize)
+                    .ok_or(format!("leaf {i} range out of bounds"))?;
+                for &p in ids {
+                    let b = bounds.get(p as usize).ok_or(format!("bad primitive id {p}"))?;
+                    if !nb.contains(b) {
+                        return Err(format!("leaf {i} does not contain primitive {p}"));
+                    }
+                    seen[p as usize] += 1;
+                }
+            } else {
+                for c in [i + 1, n.right_or_first as usize] {
+                    let cn = self.nodes.get(c).ok_or(format!("child {c} out of range"))?;
+                    if !nb.contains(&cn.bounds()) {
+                        return Err(format!("child {c} escapes parent {i}"));
+                    }
+                    stack.push(c);
+                }
+            }
+        }
+        if let Some(p) = seen.iter().position(|&s| s != 1) {
+            return Err(format!("primitive {p} appears in {} leaves", seen[p]));
+        }
+        Ok(())
+    }
+}
+
+fn build_rec(prims: &mut [Prim], first: usize) -> Tmp {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    let n = prims.len();
+    let leaf = Tmp::Leaf { bounds, first, count: n };
+    if n <= MAX_LEAF {
+        return leaf;
+    }
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let ext = cb.extent();
+    let axis = if ext.x >= ext.y && ext.x >= ext.z { 0 } else if ext.y >= ext.z { 1 } else { 2 };
+    let lo = cb.min[axis];
+    let span = ext[axis];
+    let mid = if span > 0.0 && span.is_finite() {
+        // Binned SAH along the widest centroid axis.
+        let mut bins = [(Aabb::EMPTY, 0usize); BINS];
+        let scale = BINS as f32 / span;
+        let bin_of = |c: f32| (((c - lo) * scale) as usize).min(BINS - 1);
+        for p in prims.iter() {
+            let b = &mut bins[bin_of(p.centroid[axis])];
+            b.0 = b.0.union(p.bounds);
+            b.1 += 1;
+        }
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in (1..BINS).rev() {
+            acc = acc.union(bins[i].0);
+            cnt += bins[i].1;
+            right_area[i] = acc.surface_area();
+            right_count[i] = cnt;
+        }
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        let mut best = (f32::INFINITY, 0usize);
+        for i in 0..BINS - 1 {
+            acc = acc.union(bins[i].0);
+            cnt += bins[i].1;
+            let cost = acc.surface_area() * cnt as f32 + right_area[i + 1] * right_count[i + 1] as f32;
+            if cost < best.0 {
+                best = (cost, i);
+            }
+        }
+        let leaf_cost = bounds.surface_area() * n as f32;
+        // Traversal costs about one box test; stop when splitting does not pay.
+        if n <= MAX_LEAF * 2 && best.0 + bounds.surface_area() >= leaf_cost {
+            return leaf;
+        }
+        let split = best.1;
+        partition(prims, |p| bin_of(p.centroid[axis]) <= split)
+    } else {
+        n / 2
+    };
+    let mid = if mid == 0 || mid == n { n / 2 } else { mid };
+    let (l, r) = prims.split_at_mut(mid);
+    let (left, right) = if n > PARALLEL_THRESHOLD {
+        rayon::join(|| build_rec(l, first), || build_rec(r, first + mid))
+    } else {
+        (build_rec(l, first), build_rec(r, first + mid))
+    };
+    let size = 1 + left.size() + right.size();
+    Tmp::Inner { bounds, left: Box::new(left), right: Box::new(right), size }
+}
+
+fn partition(prims: &mut [Prim], pred: impl Fn(&Prim) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..prims.len() {
+        if pred(&prims[j]) {
+            prims.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}
+
+fn flatten(root: Tmp, out: &mut Vec<BvhNode>) {
+    // Iterative, so the (bounded but deep) tree never recurses here.
+    let mut stack: Vec<(Tmp, Option<usize>)> = vec![(root, None)];
+    while let Some((node, patch_parent)) = stack.pop() {
+        let me = out.len();
+        if let Some(p) = patch_parent {
+            out[p].right_or_first = me as u32;
+        }
+        match node {
+            Tmp::Leaf { bounds, first, count } => out.push(BvhNode {
+                min: bounds.min.into(),
+                right_or_first: first as u32,
+                max: bounds.max.into(),
+                count: count as u32,
+            }),
+            Tmp::Inner { bounds, left, right, .. } => {
+                out.push(BvhNode { min: bounds.min.into(), right_or_first: 0, max: bounds.max.into(), count: 0 });
+                // Right is flattened after the whole left subtree and patches our pointer.
+                stack.push((*right, Some(me)));
+                stack.push((*left, None));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxes(n: usize) -> Vec<Aabb> {
+        // Deterministic pseudo-random boxes.
+        let mut s = 0x1234_5678u32;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            (s as f32 / u32::MAX as f32) * 10.0
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(rnd(), rnd(), rnd());
+                Aabb::new(c, c + Vec3::splat(0.1 + rnd() * 0.05))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn invariants_hold_for_various_sizes() {
+        for n in [0, 1, 2, 5, 17, 1000, 10_000] {
+            let b = boxes(n);
+            let bvh = Bvh::build(&b);
+            bvh.check_invariants(&b).unwrap_or_else(|e| panic!("n={n}: {e}"));
+        }
+    }
+
+    #[test]
+    fn identical_boxes_still_split() {
+        let b = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 100];
+        let bvh = Bvh::build(&b);
+        bvh.check_invariants(&b).expect("invariants");
+    }
+}

@@ -1,0 +1,12 @@
+//! The MIT 6.837 scene format: lexer, parser (errors as values with file:line:col),
+//! writer, and OBJ loading.
+
+mod diagnostic;
+mod lexer;
+pub mod obj;
+mod parser;
+mod writer;
+
+pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
+pub use parser::{ParseOutcome, load_scene, parse_scene};
+pub use writer::{uses_only_course_grammar, write_scene};

@@ -1,0 +1,167 @@
+//! Loading OBJ meshes with `tobj` (polygons triangulated; v, v/vt, v//vn, v/vt/vn faces),
+//! shared by path so a mesh used twice is read and its BVH built once.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::SystemTime;
+
+use glam::Vec3;
+
+use crate::scene::Mesh;
+
+/// Resolves `obj_file` against the scene's folder first, then the current folder.
+pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, String> {
+    let mut tried = Vec::new();
+    if let Some(dir) = base_dir {
+        let p = dir.join(name);
+        if p.is_file() {
+            return Ok(p);
+        }
+        tried.push(if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
+    }
+    let p = PathBuf::from(name);
+    if p.is_file() {
+        return Ok(p);
+    }
+    tried.push("the current folder".to_string());
+    Err(format!("file not found (looked in {})", tried.join(" and ")))
+}
+
+/// Meshes already loaded, by canonical path; reused while the file is unchanged on disk.
+#[derive(Default)]
+pub struct MeshCache {
+    meshes: HashMap<PathBuf, (Option<SystemTime>, u64, Arc<Mesh>)>,
+}
+
+impl MeshCache {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn load(&mut self, path: &Path) -> Result<Arc<Mesh>, String> {
+        let canon = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let meta = std::fs::metadata(&canon).map_err(|e| e.to_string())?;
+        let stamp = (meta.modified().ok(), meta.len());
+        if let Some((t, len, m)) = self.meshes.get(&canon) {
+            if (*t, *len) == stamp {
+                return Ok(m.clone());
+            }
+        }
+        let mesh = Arc::new(load_obj(&canon)?);
+        self.meshes.insert(canon, (stamp.0, stamp.1, mesh.clone()));
+        Ok(mesh)
+    }
+
+    /// Forgets a path so the next load reads it again.
+    pub fn forget(&mut self, path: &Path) {
+        let canon = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        self.meshes.remove(&canon);
+    }
+}
+
+/// Reads one OBJ file into a single mesh (all its objects and groups together).
+pub fn load_obj(path: &Path) -> Result<Mesh, String> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let (models, _materials) = match tobj::load_obj(path, &opts) {
+        Ok(r) => r,
+        Err(e) => return Err(locate_obj_error(path).unwrap_or_else(|| e.to_string())),
+    };
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for m in &models {
+        let base = positions.len() as u32;
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        let nv = positions.len() as u32;
+        for t in m.mesh.indices.chunks_exact(3) {
+            let tri = [t[0] + base, t[1] + base, t[2] + base];
+            if tri.iter().any(|&i| i >= nv) {
+                return Err(locate_obj_error(path).unwrap_or_else(|| "a face refers to a vertex that does not exist".into()));
+            }
+            triangles.push(tri);
+        }
+    }
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!("vertex {} is not finite", i + 1));
+    }
+    Ok(Mesh::new(positions, triangles))
+}
+
+/// tobj's errors carry no line; find the first line that is wrong, to say where.
+fn locate_obj_error(path: &Path) -> Option<String> {
+    let bytes = std::fs::read(path).ok()?;
+    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(t) => t,
+        Err(e) => {
+            let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+            return Some(format!("{name}:{line}: not a text OBJ file"));
+        }
+    };
+    let mut nv: i64 = 0;
+    for (ln, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let at = |msg: String| Some(format!("{name}:{}: {msg}", ln + 1));
+        match words.next() {
+            Some("v") => {
+                let coords: Vec<&str> = words.collect();
+                if coords.len() < 3 || coords.iter().take(3).any(|c| c.parse::<f32>().map_or(true, |v| !v.is_finite())) {
+                    return at(format!("bad vertex \"{}\": expected three numbers", line.trim()));
+                }
+                nv += 1;
+            }
+            Some("f") => {
+                let verts: Vec<&str> = words.collect();
+                if verts.len() < 3 {
+                    return at(format!("face \"{}\" has fewer than three vertices", line.trim()));
+                }
+                for v in verts {
+                    let idx = v.split('/').next().unwrap_or("");
+                    match idx.parse::<i64>() {
+                        Ok(i) if (i > 0 && i <= nv) || (i < 0 && -i <= nv) => {}
+                        Ok(i) => return at(format!("face refers to vertex {i}, but only {nv} vertices come before it")),
+                        Err(_) => return at(format!("bad face index \"{v}\"")),
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tracelab-obj-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let p = dir.join(name);
+        std::fs::write(&p, text).expect("write");
+        p
+    }
+
+    #[test]
+    fn quads_are_triangulated_and_slash_forms_accepted() {
+        let p = write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n");
+        let m = load_obj(&p).expect("load");
+        assert_eq!(m.triangle_count(), 2);
+    }
+
+    #[test]
+    fn bad_face_reports_obj_line() {
+        let p = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n");
+        let e = load_obj(&p).expect_err("must fail");
+        assert!(e.contains("bad.obj:4"), "{e}");
+    }
+
+    #[test]
+    fn cache_shares_one_mesh() {
+        let p = write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        let mut c = MeshCache::new();
+        let a = c.load(&p).expect("a");
+        let b = c.load(&p).expect("b");
+        assert!(Arc::ptr_eq(&a, &b));
+    }
+}

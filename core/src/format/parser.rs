@@ -1,0 +1,939 @@
+//! Recursive-descent reader for the 6.837 scene format. The object tree is parsed with an
+//! explicit stack (no recursion), so nesting depth is limited only by memory. Errors are
+//! collected, not thrown: after an error the parser skips to the end of the enclosing block
+//! and carries on, so one pass reports as many problems as it can.
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+
+use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
+use super::lexer::{TokKind, Token, tokenize};
+use super::obj::{MeshCache, resolve_obj_path};
+use crate::scene::{
+    Background, Camera, Graph, Light, Material, MaterialKeyword, MeshSlot, Node, NodeId, NodeKind,
+    Scene, TransformOp, compose,
+};
+
+/// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
+/// completely; it may still come with errors that concern single nodes (an OBJ file that
+/// could not be loaded), which `diagnostics.has_errors()` reports.
+#[derive(Debug)]
+pub struct ParseOutcome {
+    pub scene: Option<Scene>,
+    pub diagnostics: Diagnostics,
+}
+
+impl ParseOutcome {
+    /// The scene if there was no error at all, else every diagnostic.
+    pub fn into_result(self) -> Result<(Scene, Diagnostics), Diagnostics> {
+        match self.scene {
+            Some(s) if !self.diagnostics.has_errors() => Ok((s, self.diagnostics)),
+            _ => Err(self.diagnostics),
+        }
+    }
+}
+
+/// Reads and parses a scene file; OBJ paths resolve against the file's folder first.
+pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => parse_scene(&bytes, &name, path.parent(), cache),
+        Err(e) => ParseOutcome {
+            scene: None,
+            diagnostics: Diagnostics(vec![Diagnostic {
+                severity: Severity::Error,
+                file: name,
+                line: 0,
+                col: 0,
+                message: format!("cannot read scene file: {e}"),
+            }]),
+        },
+    }
+}
+
+/// Parses scene text. `name` is used in messages; `base_dir` is where OBJ files are looked
+/// for first (then the current folder).
+pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mut MeshCache) -> ParseOutcome {
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) if !t.contains('\0') => t,
+        other => {
+            let (valid_up_to, what) = match other {
+                Ok(t) => (t.find('\0').unwrap_or(0), "a NUL byte".to_string()),
+                Err(e) => {
+                    let b = bytes.get(e.valid_up_to()).copied().unwrap_or(0);
+                    (e.valid_up_to(), format!("byte 0x{b:02x}, which is not UTF-8 text"))
+                }
+            };
+            let prefix = std::str::from_utf8(&bytes[..valid_up_to]).unwrap_or("");
+            let src = SourceFile::new(name, prefix);
+            let d = src.diagnostic(
+                Severity::Error,
+                valid_up_to,
+                format!("this is not a text scene file: found {what}"),
+            );
+            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]) };
+        }
+    };
+    let mut p = Parser {
+        src: SourceFile::new(name, text),
+        toks: tokenize(text),
+        pos: 0,
+        diags: Vec::new(),
+        fatal: false,
+        base_dir,
+        cache,
+        camera: None,
+        lights: None,
+        background: None,
+        materials: Vec::new(),
+        graph: None,
+        material_refs: Vec::new(),
+        leaf_offsets: Vec::new(),
+    };
+    p.parse_file();
+    p.finish()
+}
+
+struct Parser<'a> {
+    src: SourceFile<'a>,
+    toks: Vec<Token>,
+    pos: usize,
+    diags: Vec<Diagnostic>,
+    /// Set by any error that leaves the scene incomplete.
+    fatal: bool,
+    base_dir: Option<&'a Path>,
+    cache: &'a mut MeshCache,
+    camera: Option<Camera>,
+    lights: Option<Vec<Light>>,
+    background: Option<Background>,
+    materials: Vec<Material>,
+    graph: Option<Graph>,
+    /// (index, offset) of each MaterialIndex, checked once all materials are known.
+    material_refs: Vec<(u32, usize)>,
+    /// (node, offset) of each primitive, for warnings that need the final tree.
+    leaf_offsets: Vec<(NodeId, usize)>,
+}
+
+/// One `name value…` line inside a flat block.
+struct Field {
+    name: String,
+    name_off: usize,
+    values: Vec<(f32, usize)>,
+    word: Option<(String, usize)>,
+    /// Text and offset of the token after the values, for "found …" in messages.
+    after: (String, usize),
+    used: bool,
+}
+
+enum Frame {
+    Group {
+        node: NodeId,
+        open: usize,
+        declared: Option<(usize, usize)>,
+        count: usize,
+        material: Option<u32>,
+    },
+    Transform {
+        node: NodeId,
+        keyword: usize,
+        open: usize,
+        ops: Vec<(TransformOp, usize)>,
+        has_child: bool,
+    },
+}
+
+const OBJECT_KEYWORDS: &[&str] = &["Group", "Transform", "Sphere", "Plane", "Triangle", "TriangleMesh"];
+
+fn is_numberlike(s: &str) -> bool {
+    let first = s.as_bytes().first().copied().unwrap_or(b'a');
+    first.is_ascii_digit()
+        || matches!(first, b'-' | b'+' | b'.')
+        || ["nan", "inf", "infinity"].iter().any(|k| s.eq_ignore_ascii_case(k))
+}
+
+impl<'a> Parser<'a> {
+    // ---------------------------------------------------------------- tokens and messages
+
+    fn peek(&self) -> Option<Token> {
+        self.toks.get(self.pos).copied()
+    }
+
+    fn next(&mut self) -> Option<Token> {
+        let t = self.peek();
+        if t.is_some() {
+            self.pos += 1;
+        }
+        t
+    }
+
+    fn text(&self, t: Token) -> &'a str {
+        let text: &'a str = self.src.text;
+        &text[t.start..t.end]
+    }
+
+    /// How a token reads in a "found …" message.
+    fn describe(&self, t: Option<Token>) -> (String, usize) {
+        match t {
+            Some(t) => (format!("\"{}\"", self.text(t)), t.start),
+            None => ("the end of the file".to_string(), self.src.text.len()),
+        }
+    }
+
+    fn error(&mut self, offset: usize, msg: impl Into<String>) {
+        self.fatal = true;
+        let d = self.src.diagnostic(Severity::Error, offset, msg);
+        self.diags.push(d);
+    }
+
+    fn node_error(&mut self, offset: usize, msg: impl Into<String>) {
+        let d = self.src.diagnostic(Severity::Error, offset, msg);
+        self.diags.push(d);
+    }
+
+    fn warn(&mut self, offset: usize, msg: impl Into<String>) {
+        let d = self.src.diagnostic(Severity::Warning, offset, msg);
+        self.diags.push(d);
+    }
+
+    /// Skips to just past the `}` that closes a block whose `{` was already read.
+    fn skip_block(&mut self) {
+        let mut depth = 1usize;
+        while let Some(t) = self.next() {
+            match t.kind {
+                TokKind::Open => depth += 1,
+                TokKind::Close => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return;
+                    }
+                }
+                TokKind::Word => {}
+            }
+        }
+    }
+
+    /// Reads the `{` after a keyword; on failure reports it and returns None.
+    fn expect_open(&mut self, keyword: &str) -> Option<usize> {
+        match self.peek() {
+            Some(t) if t.kind == TokKind::Open => {
+                self.pos += 1;
+                Some(t.start)
+            }
+            other => {
+                let (found, off) = self.describe(other);
+                self.error(off, format!("expected \"{{\" after \"{keyword}\", found {found}"));
+                None
+            }
+        }
+    }
+
+    /// A whole number after `keyword` (numObjects, MaterialIndex, …).
+    fn expect_count(&mut self, keyword: &str) -> Option<(usize, usize)> {
+        let t = self.peek();
+        if let Some(t) = t.filter(|t| t.kind == TokKind::Word) {
+            if let Ok(n) = self.text(t).parse::<usize>() {
+                self.pos += 1;
+                return Some((n, t.start));
+            }
+            if is_numberlike(self.text(t)) {
+                self.pos += 1;
+                let msg = format!("expected a whole number after \"{keyword}\", found \"{}\"", self.text(t));
+                self.error(t.start, msg);
+                return None;
+            }
+        }
+        let (found, off) = self.describe(t);
+        self.error(off, format!("expected a whole number after \"{keyword}\", found {found}"));
+        None
+    }
+
+    /// Reads one number token; reports bad and non-finite numbers.
+    fn number_token(&mut self, t: Token, after: &str) -> Option<f32> {
+        let s = self.text(t);
+        match s.parse::<f32>() {
+            Ok(v) if v.is_finite() => Some(v),
+            Ok(_) => {
+                self.error(t.start, format!("\"{s}\" after \"{after}\" is not a finite number"));
+                None
+            }
+            Err(_) => {
+                self.error(t.start, format!("expected a number after \"{after}\", found \"{s}\""));
+                None
+            }
+        }
+    }
+
+    /// Exactly `n` numbers after `keyword` (for transform ops).
+    fn expect_numbers(&mut self, keyword: &str, n: usize) -> Option<Vec<f32>> {
+        let mut out = Vec::with_capacity(n);
+        for _ in 0..n {
+            let t = self.peek();
+            match t {
+                Some(t) if t.kind == TokKind::Word && is_numberlike(self.text(t)) => {
+                    self.pos += 1;
+                    out.push(self.number_token(t, keyword)?);
+                }
+                other => {
+                    let (found, off) = self.describe(other);
+                    let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
+                    self.error(off, format!("expected {what} after \"{keyword}\", found {found}"));
+                    return None;
+                }
+            }
+        }
+        Some(out)
+    }
+
+    // ---------------------------------------------------------------- flat blocks
+
+    /// Reads `name numbers…` lines up to the closing `}` of a block whose `{` was read.
+    /// Returns None (having reported why) if the block is malformed.
+    fn read_fields(&mut self, block: &str, open: usize) -> Option<Vec<Field>> {
+        let mut fields: Vec<Field> = Vec::new();
+        let mut ok = true;
+        loop {
+            let Some(t) = self.next() else {
+                self.error(open, format!("unterminated {block} block: expected \"}}\" before the end of the file"));
+                return None;
+            };
+            match t.kind {
+                TokKind::Close => break,
+                TokKind::Open => {
+                    self.error(t.start, format!("unexpected \"{{\" inside {block}"));
+                    self.skip_block();
+                    ok = false;
+                }
+                TokKind::Word => {
+                    let name = self.text(t);
+                    if is_numberlike(name) {
+                        if ok {
+                            let msg = match fields.last() {
+                                Some(f) if f.values.is_empty() && f.word.is_none() => {
+                                    format!("expected a number after \"{}\", found \"{name}\"", f.name)
+                                }
+                                _ => format!("unexpected number \"{name}\" in {block}"),
+                            };
+                            self.error(t.start, msg);
+                        }
+                        ok = false;
+                        continue;
+                    }
+                    let mut field = Field {
+                        name: name.to_string(),
+                        name_off: t.start,
+                        values: Vec::new(),
+                        word: None,
+                        after: (String::new(), 0),
+                        used: false,
+                    };
+                    if name == "obj_file" {
+                        match self.peek() {
+                            Some(w) if w.kind == TokKind::Word => {
+                                self.pos += 1;
+                                field.word = Some((self.text(w).to_string(), w.start));
+                            }
+                            other => {
+                                let (found, off) = self.describe(other);
+                                self.error(off, format!("expected a file name after \"obj_file\", found {found}"));
+                                ok = false;
+                            }
+                        }
+                    } else {
+                        while let Some(v) = self.peek().filter(|v| v.kind == TokKind::Word) {
+                            if !is_numberlike(self.text(v)) {
+                                break;
+                            }
+                            self.pos += 1;
+                            match self.number_token(v, name) {
+                                Some(x) => field.values.push((x, v.start)),
+                                None => ok = false,
+                            }
+                        }
+                    }
+                    field.after = self.describe(self.peek());
+                    fields.push(field);
+                }
+            }
+        }
+        ok.then_some(fields)
+    }
+
+    /// Takes field `name` with exactly `n` numbers; reports what is wrong otherwise.
+    fn take(&mut self, fields: &mut [Field], block: &str, block_off: usize, name: &str, n: usize) -> Option<Vec<f32>> {
+        let Some(i) = fields.iter().position(|f| f.name == name && !f.used) else {
+            self.error(block_off, format!("{block} is missing \"{name}\""));
+            return None;
+        };
+        fields[i].used = true;
+        let f = &fields[i];
+        if f.values.len() < n {
+            let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
+            let (found, off) = f.after.clone();
+            self.error(off, format!("expected {what} after \"{name}\", found {found}"));
+            return None;
+        }
+        if f.values.len() > n {
+            let (extra, off) = (f.values[n].0, f.values[n].1);
+            self.error(off, format!("\"{name}\" takes {n} number(s); found an extra \"{extra}\""));
+            return None;
+        }
+        Some(f.values.iter().map(|v| v.0).collect())
+    }
+
+    fn take_vec3(&mut self, fields: &mut [Field], block: &str, off: usize, name: &str) -> Option<Vec3> {
+        self.take(fields, block, off, name, 3).map(|v| Vec3::new(v[0], v[1], v[2]))
+    }
+
+    fn take_f32(&mut self, fields: &mut [Field], block: &str, off: usize, name: &str) -> Option<f32> {
+        self.take(fields, block, off, name, 1).map(|v| v[0])
+    }
+
+    /// Reports fields nobody took (unknown or repeated names).
+    fn reject_unused(&mut self, fields: &[Field], block: &str, expected: &str) -> bool {
+        let mut ok = true;
+        for f in fields.iter().filter(|f| !f.used) {
+            let repeated = fields.iter().any(|g| g.used && g.name == f.name);
+            let msg = if repeated {
+                format!("\"{}\" is given twice in {block}", f.name)
+            } else {
+                format!("unknown field \"{}\" in {block} (expected {expected})", f.name)
+            };
+            self.error(f.name_off, msg);
+            ok = false;
+        }
+        ok
+    }
+
+    // ---------------------------------------------------------------- top level
+
+    fn parse_file(&mut self) {
+        while let Some(t) = self.next() {
+            match t.kind {
+                TokKind::Open => {
+                    self.error(t.start, "unexpected \"{\" outside any block");
+                    self.skip_block();
+                }
+                TokKind::Close => self.error(t.start, "unexpected \"}\" outside any block"),
+                TokKind::Word => {
+                    let kw = self.text(t);
+                    match kw {
+                        "OrthographicCamera" | "PerspectiveCamera" => self.parse_camera(kw, t.start),
+                        "Lights" => self.parse_lights(t.start),
+                        "Background" => self.parse_background(t.start),
+                        "Materials" => self.parse_materials(t.start),
+                        "Group" => self.parse_object_tree(t.start),
+                        _ => {
+                            let hint = if OBJECT_KEYWORDS.contains(&kw) {
+                                " (objects belong inside the top-level Group)"
+                            } else {
+                                " (expected OrthographicCamera, PerspectiveCamera, Lights, Background, Materials or Group)"
+                            };
+                            self.error(t.start, format!("unknown keyword \"{kw}\"{hint}"));
+                            if self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                                self.pos += 1;
+                                self.skip_block();
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn parse_camera(&mut self, kw: &str, off: usize) {
+        let Some(open) = self.expect_open(kw) else { return };
+        let Some(mut f) = self.read_fields(kw, open) else { return };
+        if self.camera.is_some() {
+            self.error(off, "a scene has one camera; this is a second");
+        }
+        let center = self.take_vec3(&mut f, kw, off, "center");
+        let direction = self.take_vec3(&mut f, kw, off, "direction");
+        let up = self.take_vec3(&mut f, kw, off, "up");
+        let perspective = kw == "PerspectiveCamera";
+        let last = if perspective { "angle" } else { "size" };
+        let extent = self.take_f32(&mut f, kw, off, last);
+        self.reject_unused(&f, kw, &format!("center, direction, up, {last}"));
+        let (Some(center), Some(direction), Some(up), Some(extent)) = (center, direction, up, extent) else {
+            return;
+        };
+        if direction.length_squared() == 0.0 {
+            self.error(off, format!("{kw}: direction must not be zero"));
+            return;
+        }
+        if up.cross(direction).length_squared() <= 1e-12 * up.length_squared() * direction.length_squared() {
+            self.error(off, format!("{kw}: up must not be zero or parallel to direction"));
+            return;
+        }
+        if perspective && !(extent > 0.0 && extent < 180.0) {
+            self.error(off, format!("PerspectiveCamera: angle must be between 0 and 180 degrees, found {extent}"));
+            return;
+        }
+        if !perspective && extent <= 0.0 {
+            self.error(off, format!("OrthographicCamera: size must be positive, found {extent}"));
+            return;
+        }
+        self.camera = Some(if perspective {
+            Camera::Perspective { center, direction, up, angle: extent }
+        } else {
+            Camera::Orthographic { center, direction, up, size: extent }
+        });
+    }
+
+    fn parse_background(&mut self, off: usize) {
+        let Some(open) = self.expect_open("Background") else { return };
+        let Some(mut f) = self.read_fields("Background", open) else { return };
+        let mut bg = Background::default();
+        if f.iter().any(|x| x.name == "color") {
+            bg.color = self.take_vec3(&mut f, "Background", off, "color");
+        }
+        if f.iter().any(|x| x.name == "ambientLight") {
+            bg.ambient = self.take_vec3(&mut f, "Background", off, "ambientLight");
+        }
+        self.reject_unused(&f, "Background", "color, ambientLight");
+        if self.background.is_some() {
+            self.error(off, "a scene has one Background; this is a second");
+        }
+        self.background = Some(bg);
+    }
+
+    fn parse_lights(&mut self, off: usize) {
+        let Some(open) = self.expect_open("Lights") else { return };
+        if self.lights.is_some() {
+            self.error(off, "a scene has one Lights block; this is a second");
+        }
+        let mut lights = Vec::new();
+        let mut declared = None;
+        loop {
+            let Some(t) = self.next() else {
+                self.error(open, "unterminated Lights block: expected \"}\" before the end of the file");
+                return;
+            };
+            match (t.kind, self.text(t)) {
+                (TokKind::Close, _) => break,
+                (TokKind::Word, "numLights") => declared = self.expect_count("numLights"),
+                (TokKind::Word, "DirectionalLight") => {
+                    let Some(o) = self.expect_open("DirectionalLight") else { continue };
+                    let Some(mut f) = self.read_fields("DirectionalLight", o) else { continue };
+                    let d = self.take_vec3(&mut f, "DirectionalLight", t.start, "direction");
+                    let c = self.take_vec3(&mut f, "DirectionalLight", t.start, "color");
+                    self.reject_unused(&f, "DirectionalLight", "direction, color");
+                    if let (Some(direction), Some(color)) = (d, c) {
+                        if direction.length_squared() == 0.0 {
+                            self.error(t.start, "DirectionalLight: direction must not be zero");
+                        }
+                        lights.push(Light { direction, color });
+                    }
+                }
+                (_, w) => {
+                    self.error(t.start, format!("unknown keyword \"{w}\" in Lights (expected numLights or DirectionalLight)"));
+                    if t.kind == TokKind::Open || self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                        if t.kind != TokKind::Open {
+                            self.pos += 1;
+                        }
+                        self.skip_block();
+                    }
+                }
+            }
+        }
+        match declared {
+            Some((n, at)) if n != lights.len() => {
+                self.error(at, format!("numLights says {n} but the block holds {} light(s)", lights.len()))
+            }
+            None => self.warn(off, "Lights has no numLights; counting the lights instead"),
+            _ => {}
+        }
+        self.lights = Some(lights);
+    }
+
+    fn parse_material_block(&mut self, kw: &str, off: usize) -> Option<Material> {
+        let open = self.expect_open(kw)?;
+        let mut f = self.read_fields(kw, open)?;
+        let diffuse = self.take_vec3(&mut f, kw, off, "diffuseColor")?;
+        let keyword = if kw == "PhongMaterial" { MaterialKeyword::PhongMaterial } else { MaterialKeyword::Material };
+        // Other fields (specularColor, exponent, …) are kept, not shaded with.
+        let extra = f
+            .iter()
+            .filter(|x| !x.used)
+            .map(|x| (x.name.clone(), x.values.iter().map(|v| v.0).collect()))
+            .collect();
+        Some(Material { diffuse, keyword, extra })
+    }
+
+    fn parse_materials(&mut self, off: usize) {
+        let Some(open) = self.expect_open("Materials") else { return };
+        let mut declared = None;
+        let mut count = 0;
+        loop {
+            let Some(t) = self.next() else {
+                self.error(open, "unterminated Materials block: expected \"}\" before the end of the file");
+                return;
+            };
+            match (t.kind, self.text(t)) {
+                (TokKind::Close, _) => break,
+                (TokKind::Word, "numMaterials") => declared = self.expect_count("numMaterials"),
+                (TokKind::Word, kw @ ("Material" | "PhongMaterial")) => {
+                    count += 1;
+                    if let Some(m) = self.parse_material_block(kw, t.start) {
+                        self.materials.push(m);
+                    }
+                }
+                (_, w) => {
+                    self.error(
+                        t.start,
+                        format!("unknown keyword \"{w}\" in Materials (expected numMaterials, Material or PhongMaterial)"),
+                    );
+                    if t.kind == TokKind::Open || self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                        if t.kind != TokKind::Open {
+                            self.pos += 1;
+                        }
+                        self.skip_block();
+                    }
+                }
+            }
+        }
+        match declared {
+            Some((n, at)) if n != count => {
+                self.error(at, format!("numMaterials says {n} but the block holds {count} material(s)"))
+            }
+            None => self.warn(off, "Materials has no numMaterials; counting the materials instead"),
+            _ => {}
+        }
+    }
+
+    // ---------------------------------------------------------------- the object tree
+
+    fn parse_object_tree(&mut self, off: usize) {
+        let Some(open) = self.expect_open("Group") else { return };
+        if self.graph.is_some() {
+            self.error(off, "a scene has one top-level Group; this is a second");
+            self.skip_block();
+            return;
+        }
+        let mut graph = Graph::new();
+        let root = graph.root();
+        let mut stack =
+            vec![Frame::Group { node: root, open, declared: None, count: 0, material: None }];
+        while !stack.is_empty() {
+            let Some(t) = self.next() else {
+                let (kind, open) = match stack.last() {
+                    Some(Frame::Group { open, .. }) => ("Group", *open),
+                    Some(Frame::Transform { open, .. }) => ("Transform", *open),
+                    None => break,
+                };
+                self.error(open, format!("unterminated {kind} block: expected \"}}\" before the end of the file"));
+                break;
+            };
+            match t.kind {
+                TokKind::Close => {
+                    if let Some(frame) = stack.pop() {
+                        self.close_frame(frame, &mut graph);
+                    }
+                }
+                TokKind::Open => {
+                    self.error(t.start, "unexpected \"{\"");
+                    self.skip_block();
+                }
+                TokKind::Word => {
+                    let w = self.text(t);
+                    if let Some(frame) = stack.last_mut() {
+                        match frame {
+                            Frame::Group { node, declared, count, material, .. } => {
+                                let parent = *node;
+                                match w {
+                                    "numObjects" => {
+                                        if declared.is_some() {
+                                            self.error(t.start, "numObjects is given twice in this Group");
+                                        }
+                                        let d = self.expect_count("numObjects");
+                                        if let Some(Frame::Group { declared, .. }) = stack.last_mut() {
+                                            *declared = d.or(*declared);
+                                        }
+                                    }
+                                    "MaterialIndex" => {
+                                        if let Some((i, at)) = self.expect_count("MaterialIndex") {
+                                            let i = u32::try_from(i).unwrap_or(u32::MAX);
+                                            self.material_refs.push((i, at));
+                                            *material = Some(i);
+                                        }
+                                    }
+                                    // The lecture's shorthand: a Material placed in a Group adds
+                                    // it and applies it to what follows.
+                                    "Material" => {
+                                        if let Some(m) = self.parse_material_block("Material", t.start) {
+                                            self.materials.push(m);
+                                            let idx = (self.materials.len() - 1) as u32;
+                                            if let Some(Frame::Group { material, .. }) = stack.last_mut() {
+                                                *material = Some(idx);
+                                            }
+                                        }
+                                    }
+                                    _ if OBJECT_KEYWORDS.contains(&w) => {
+                                        *count += 1;
+                                        let mat = *material;
+                                        if let Some(f) = self.start_object(w, t.start, parent, mat, &mut graph) {
+                                            stack.push(f);
+                                        }
+                                    }
+                                    _ => {
+                                        self.error(
+                                            t.start,
+                                            format!(
+                                                "unknown keyword \"{w}\" in Group (expected numObjects, MaterialIndex or an object: {})",
+                                                OBJECT_KEYWORDS.join(", ")
+                                            ),
+                                        );
+                                        self.skip_following_block();
+                                    }
+                                }
+                            }
+                            Frame::Transform { node, has_child, .. } => {
+                                let parent = *node;
+                                if OBJECT_KEYWORDS.contains(&w) {
+                                    if *has_child {
+                                        self.error(t.start, "a Transform holds exactly one object; this is a second (wrap them in a Group)");
+                                    }
+                                    *has_child = true;
+                                    if let Some(f) = self.start_object(w, t.start, parent, None, &mut graph) {
+                                        stack.push(f);
+                                    }
+                                } else if let Some(op) = self.parse_op(w, t.start) {
+                                    match stack.last_mut() {
+                                        Some(Frame::Transform { ops, has_child: false, .. }) => ops.push((op, t.start)),
+                                        _ => self.error(t.start, "transform operations must come before the Transform's object"),
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.graph = Some(graph);
+    }
+
+    fn skip_following_block(&mut self) {
+        if self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+            self.pos += 1;
+            self.skip_block();
+        }
+    }
+
+    /// Parses a transform op after its keyword. Reports and returns None on failure
+    /// (including an unknown keyword).
+    fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
+        let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
+        Some(match w {
+            "Scale" => TransformOp::Scale(v3(self.expect_numbers(w, 3)?)),
+            "UniformScale" => TransformOp::UniformScale(self.expect_numbers(w, 1)?[0]),
+            "Translate" => TransformOp::Translate(v3(self.expect_numbers(w, 3)?)),
+            "XRotate" => TransformOp::XRotate(self.expect_numbers(w, 1)?[0]),
+            "YRotate" => TransformOp::YRotate(self.expect_numbers(w, 1)?[0]),
+            "ZRotate" => TransformOp::ZRotate(self.expect_numbers(w, 1)?[0]),
+            "Rotate" | "Matrix" => {
+                self.expect_open(w)?;
+                let n = if w == "Rotate" { 4 } else { 16 };
+                let v = self.expect_numbers(w, n);
+                match self.peek() {
+                    Some(c) if c.kind == TokKind::Close && v.is_some() => self.pos += 1,
+                    other => {
+                        if v.is_some() {
+                            let (found, at) = self.describe(other);
+                            self.error(at, format!("expected \"}}\" to close {w} after {n} numbers, found {found}"));
+                        }
+                        // Resynchronise at the end of this block.
+                        self.skip_block();
+                        return None;
+                    }
+                }
+                let v = v?;
+                if w == "Rotate" {
+                    TransformOp::Rotate { axis: Vec3::new(v[0], v[1], v[2]), degrees: v[3] }
+                } else {
+                    let mut a = [0.0f32; 16];
+                    a.copy_from_slice(&v);
+                    // Written row by row; glam stores columns.
+                    TransformOp::Matrix(Mat4::from_cols_array(&a).transpose())
+                }
+            }
+            _ => {
+                self.error(
+                    off,
+                    format!(
+                        "unknown keyword \"{w}\" in Transform (expected Scale, UniformScale, Translate, XRotate, YRotate, ZRotate, Rotate, Matrix or one object)"
+                    ),
+                );
+                self.skip_following_block();
+                return None;
+            }
+        })
+    }
+
+    /// Starts an object after its keyword: containers return a frame to push; primitives
+    /// are read whole and attached.
+    fn start_object(
+        &mut self,
+        w: &str,
+        off: usize,
+        parent: NodeId,
+        material: Option<u32>,
+        graph: &mut Graph,
+    ) -> Option<Frame> {
+        let open = self.expect_open(w)?;
+        let attach = |graph: &mut Graph, kind: NodeKind| {
+            let id = graph.add(Node { kind, material, children: Vec::new() });
+            graph.push_child(parent, id);
+            id
+        };
+        match w {
+            "Group" => {
+                let node = attach(graph, NodeKind::Group);
+                Some(Frame::Group { node, open, declared: None, count: 0, material: None })
+            }
+            "Transform" => {
+                let node = attach(graph, NodeKind::Transform(Vec::new()));
+                Some(Frame::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
+            }
+            _ => {
+                if let Some(kind) = self.parse_primitive(w, off, open) {
+                    let id = attach(graph, kind);
+                    self.leaf_offsets.push((id, off));
+                }
+                None
+            }
+        }
+    }
+
+    fn parse_primitive(&mut self, w: &str, off: usize, open: usize) -> Option<NodeKind> {
+        let mut f = self.read_fields(w, open)?;
+        let kind = match w {
+            "Sphere" => {
+                let center = self.take_vec3(&mut f, w, off, "center");
+                let radius = self.take_f32(&mut f, w, off, "radius");
+                self.reject_unused(&f, w, "center, radius");
+                NodeKind::Sphere { center: center?, radius: radius? }
+            }
+            "Plane" => {
+                let normal = self.take_vec3(&mut f, w, off, "normal");
+                let offset = self.take_f32(&mut f, w, off, "offset");
+                self.reject_unused(&f, w, "normal, offset");
+                let normal = normal?;
+                if normal.length_squared() == 0.0 {
+                    self.error(off, "Plane: normal must not be zero");
+                    return None;
+                }
+                NodeKind::Plane { normal, offset: offset? }
+            }
+            "Triangle" => {
+                let a = self.take_vec3(&mut f, w, off, "vertex0");
+                let b = self.take_vec3(&mut f, w, off, "vertex1");
+                let c = self.take_vec3(&mut f, w, off, "vertex2");
+                self.reject_unused(&f, w, "vertex0, vertex1, vertex2");
+                NodeKind::Triangle { vertices: [a?, b?, c?] }
+            }
+            "TriangleMesh" => {
+                let Some(i) = f.iter().position(|x| x.name == "obj_file") else {
+                    self.error(off, "TriangleMesh is missing \"obj_file\"");
+                    return None;
+                };
+                f[i].used = true;
+                self.reject_unused(&f, w, "obj_file");
+                let (name, name_off) = f[i].word.clone()?;
+                let mesh = self.load_mesh(&name, name_off);
+                NodeKind::TriangleMesh { obj_file: name, mesh }
+            }
+            _ => return None,
+        };
+        Some(kind)
+    }
+
+    fn load_mesh(&mut self, name: &str, off: usize) -> MeshSlot {
+        let result = resolve_obj_path(name, self.base_dir).and_then(|path| self.cache.load(&path));
+        match result {
+            Ok(mesh) => {
+                if mesh.triangle_count() == 0 {
+                    self.warn(off, format!("OBJ file \"{name}\" has no triangles"));
+                }
+                MeshSlot::Loaded(mesh)
+            }
+            Err(msg) => {
+                // The scene is still usable; this node renders nothing until fixed.
+                self.node_error(off, format!("cannot load OBJ file \"{name}\": {msg}"));
+                MeshSlot::Failed(msg)
+            }
+        }
+    }
+
+    fn close_frame(&mut self, frame: Frame, graph: &mut Graph) {
+        match frame {
+            Frame::Group { declared: Some((n, at)), count, .. } if n != count => {
+                self.error(at, format!("numObjects says {n} but the Group holds {count} object(s)"));
+            }
+            Frame::Group { .. } => {}
+            Frame::Transform { node, keyword, ops, has_child, .. } => {
+                if !has_child {
+                    self.error(keyword, "Transform needs one object after its operations");
+                }
+                let m = compose(&ops.iter().map(|o| o.0.clone()).collect::<Vec<_>>());
+                let det = m.determinant();
+                if !det.is_finite() || det.abs() < 1e-12 {
+                    // Point at the op that flattens space, if one does on its own.
+                    let (what, at) = ops
+                        .iter()
+                        .find(|(op, _)| op.matrix().determinant().abs() < 1e-12)
+                        .map(|(op, at)| (op.summary(), *at))
+                        .unwrap_or(("the combined operations".to_string(), keyword));
+                    self.error(at, format!("singular transform: {what} flattens space, so rays cannot be moved into object space"));
+                }
+                graph.node_mut(node).kind = NodeKind::Transform(ops.into_iter().map(|o| o.0).collect());
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- completion
+
+    fn finish(mut self) -> ParseOutcome {
+        let end = self.src.text.len();
+        let n = self.materials.len();
+        for (i, at) in std::mem::take(&mut self.material_refs) {
+            if i as usize >= n {
+                let range = if n == 0 { "the scene has no materials".to_string() } else { format!("valid indices are 0 to {}", n - 1) };
+                self.error(at, format!("MaterialIndex {i} is out of range: {range}"));
+            }
+        }
+        if self.camera.is_none() {
+            self.error(end, "the scene has no camera (OrthographicCamera or PerspectiveCamera)");
+        }
+        if self.graph.is_none() {
+            self.error(end, "the scene has no Group of objects");
+        }
+        if let Some(graph) = &self.graph {
+            let eff = graph.effective_materials();
+            let missing: Vec<usize> = self
+                .leaf_offsets
+                .iter()
+                .filter(|(id, _)| eff.get(id.index()).copied().flatten().is_none())
+                .map(|(_, at)| *at)
+                .collect();
+            for (k, at) in missing.iter().enumerate() {
+                if k == 5 {
+                    self.warn(*at, format!("{} more objects have no material", missing.len() - 5));
+                    break;
+                }
+                self.warn(*at, "no MaterialIndex applies to this object; it uses the default grey material");
+            }
+        }
+        let scene = if self.fatal {
+            None
+        } else {
+            Some(Scene {
+                camera: self.camera.take().unwrap_or_default(),
+                lights: self.lights.take(),
+                background: self.background.take().unwrap_or_default(),
+                materials: std::mem::take(&mut self.materials),
+                graph: self.graph.take().unwrap_or_default(),
+            })
+        };
+        ParseOutcome { scene, diagnostics: Diagnostics(self.diags) }
+    }
+}

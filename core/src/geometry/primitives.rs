@@ -1,0 +1,143 @@
+//! Closest-hit routines for the analytic primitives. Each returns the smallest t in
+//! (t_min, t_max) and leaves normals to the caller, who builds them once for the closest hit.
+
+use glam::Vec3;
+
+use super::Ray;
+
+/// Smallest root of |o + t d − c|² = r² in (t_min, t_max). Works for unnormalised d.
+#[inline]
+pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max: f32) -> Option<f32> {
+    let oc = ray.origin - center;
+    let a = ray.direction.length_squared();
+    let half_b = oc.dot(ray.direction);
+    let c = oc.length_squared() - radius * radius;
+    let disc = half_b * half_b - a * c;
+    if disc < 0.0 || a == 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    // Numerically stable pair of roots.
+    let q = -half_b - sq.copysign(half_b);
+    let (mut t0, mut t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > t_min && t0 < t_max {
+        Some(t0)
+    } else if t1 > t_min && t1 < t_max {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+/// The plane {p : n·p = offset}. A ray parallel to it never hits.
+#[inline]
+pub fn intersect_plane(ray: &Ray, normal: Vec3, offset: f32, t_min: f32, t_max: f32) -> Option<f32> {
+    let denom = normal.dot(ray.direction);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = (offset - normal.dot(ray.origin)) / denom;
+    (t > t_min && t < t_max).then_some(t)
+}
+
+/// Möller–Trumbore, two-sided. Returns (t, u, v).
+#[inline]
+pub fn intersect_triangle(
+    ray: &Ray,
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    t_min: f32,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
+    let e1 = b - a;
+    let e2 = c - a;
+    let p = ray.direction.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = ray.origin - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = ray.direction.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    (t > t_min && t < t_max).then_some((t, u, v))
+}
+
+/// The face normal (b − a) × (c − a), normalised: counter-clockwise vertices face the viewer.
+pub fn triangle_normal(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    (b - a).cross(c - a).normalize_or_zero()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_hit_from_outside_gives_near_root() {
+        let r = Ray::new(Vec3::new(0.0, 0.0, 10.0), Vec3::NEG_Z);
+        let t = intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY);
+        assert_eq!(t, Some(9.0));
+    }
+
+    #[test]
+    fn sphere_hit_from_inside_gives_far_root() {
+        let r = Ray::new(Vec3::ZERO, Vec3::X);
+        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 2.0, 0.0, f32::INFINITY), Some(2.0));
+    }
+
+    #[test]
+    fn sphere_with_unnormalised_direction_keeps_parameter_meaning() {
+        let r = Ray::new(Vec3::new(0.0, 0.0, 10.0), Vec3::new(0.0, 0.0, -2.0));
+        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), Some(4.5));
+    }
+
+    #[test]
+    fn sphere_miss_and_negative_tmin_behaviour() {
+        let r = Ray::new(Vec3::new(0.0, 5.0, 10.0), Vec3::NEG_Z);
+        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), None);
+        // Sphere behind the origin is found only with t_min = -inf (orthographic cameras).
+        let r = Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::NEG_Z);
+        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), None);
+        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, f32::NEG_INFINITY, f32::INFINITY), Some(-11.0));
+    }
+
+    #[test]
+    fn plane_hit_matches_offset() {
+        let r = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y);
+        assert_eq!(intersect_plane(&r, Vec3::Y, -2.0, 0.0, f32::INFINITY), Some(7.0));
+        let parallel = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::X);
+        assert_eq!(intersect_plane(&parallel, Vec3::Y, -2.0, 0.0, f32::INFINITY), None);
+    }
+
+    #[test]
+    fn triangle_hit_inside_and_miss_outside() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let r = Ray::new(Vec3::new(0.25, 0.25, 3.0), Vec3::NEG_Z);
+        let (t, u, v) = intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).expect("hit");
+        assert!((t - 3.0).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.25).abs() < 1e-6);
+        let r = Ray::new(Vec3::new(0.75, 0.75, 3.0), Vec3::NEG_Z);
+        assert!(intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).is_none());
+        // Two-sided: hit from behind too.
+        let r = Ray::new(Vec3::new(0.25, 0.25, -3.0), Vec3::Z);
+        assert!(intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).is_some());
+        assert_eq!(triangle_normal(a, b, c), Vec3::Z);
+    }
+
+    #[test]
+    fn degenerate_triangle_never_hits() {
+        let r = Ray::new(Vec3::new(0.5, 0.0, 3.0), Vec3::NEG_Z);
+        assert!(intersect_triangle(&r, Vec3::ZERO, Vec3::X, Vec3::X * 2.0, 0.0, f32::INFINITY).is_none());
+    }
+}

@@ -1,0 +1,21 @@
+//! tracelab-core: the scene graph, the MIT 6.837 scene format (reader and writer), geometry,
+//! acceleration structures and the progressive CPU ray tracer. No GUI dependencies.
+#![deny(unsafe_code)]
+
+pub mod accel;
+pub mod format;
+pub mod geometry;
+pub mod render;
+pub mod scene;
+
+pub use format::{Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, parse_scene, write_scene};
+pub use format::obj::MeshCache;
+pub use render::{
+    CompiledScene, Frame, NormalTransform, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
+    render_progressive,
+};
+pub use scene::{
+    DEFAULT_MATERIAL_COLOR,
+    Background, Camera, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
+    NodeKind, Scene, TransformOp,
+};

@@ -1,0 +1,100 @@
+//! Primary rays, with the course's conventions: pixel centres, j = 0 at the bottom, and for
+//! non-square images the larger dimension spans the camera's size or angle (square pixels,
+//! the smaller dimension cropped symmetrically).
+
+use glam::Vec3;
+
+use crate::geometry::Ray;
+use crate::scene::Camera;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRays {
+    center: Vec3,
+    direction: Vec3,
+    horizontal: Vec3,
+    up: Vec3,
+    /// Orthographic: full size of the screen. Perspective: 2·tan(angle/2).
+    extent: f32,
+    perspective: bool,
+}
+
+impl CameraRays {
+    pub fn new(camera: &Camera) -> Self {
+        let (center, dir, up, extent, perspective) = match *camera {
+            Camera::Orthographic { center, direction, up, size } => (center, direction, up, size, false),
+            Camera::Perspective { center, direction, up, angle } => {
+                (center, direction, up, 2.0 * (angle.to_radians() * 0.5).tan(), true)
+            }
+        };
+        let direction = dir.normalize_or(Vec3::NEG_Z);
+        let horizontal = direction.cross(up).normalize_or(Vec3::X);
+        let up = horizontal.cross(direction);
+        CameraRays { center, direction, horizontal, up, extent, perspective }
+    }
+
+    /// Orthographic rays must find hits behind the camera centre (scene1_07 relies on it).
+    pub fn t_min(&self) -> f32 {
+        if self.perspective { 0.0 } else { f32::NEG_INFINITY }
+    }
+
+    /// The ray through screen point (x, y) in [0, 1]², y up.
+    pub fn ray_at(&self, x: f32, y: f32) -> Ray {
+        let (sx, sy) = ((x - 0.5) * self.extent, (y - 0.5) * self.extent);
+        if self.perspective {
+            let d = self.direction + sx * self.horizontal + sy * self.up;
+            Ray::new(self.center, d.normalize())
+        } else {
+            Ray::new(self.center + sx * self.horizontal + sy * self.up, self.direction)
+        }
+    }
+
+    /// The ray through the centre of pixel (i, row) of a width × height image, rows counted
+    /// from the top as images store them.
+    pub fn pixel_ray(&self, i: u32, row: u32, width: u32, height: u32) -> Ray {
+        let (x, y) = screen_point(i, row, width, height);
+        self.ray_at(x, y)
+    }
+}
+
+/// Screen coordinates of pixel (i, row): ((i+0.5)/W, (j+0.5)/H) with j = H−1−row counted from
+/// the bottom, cropped to square pixels for non-square images.
+pub fn screen_point(i: u32, row: u32, width: u32, height: u32) -> (f32, f32) {
+    let s = width.max(height) as f32;
+    let j = height - 1 - row.min(height - 1);
+    let x = (i as f32 + 0.5 + (s - width as f32) * 0.5) / s;
+    let y = (j as f32 + 0.5 + (s - height as f32) * 0.5) / s;
+    (x, y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn square_pixels_sample_centres_bottom_up() {
+        assert_eq!(screen_point(0, 1, 2, 2), (0.25, 0.25));
+        assert_eq!(screen_point(1, 0, 2, 2), (0.75, 0.75));
+    }
+
+    #[test]
+    fn wide_images_crop_vertically() {
+        // 4×2: the width spans the screen; rows sit in the middle half.
+        let (x, y) = screen_point(0, 1, 4, 2);
+        assert_eq!((x, y), (0.125, 0.375));
+        let (_, y) = screen_point(0, 0, 4, 2);
+        assert_eq!(y, 0.625);
+    }
+
+    #[test]
+    fn orthographic_basis_follows_course() {
+        let c = CameraRays::new(&Camera::Orthographic {
+            center: Vec3::new(0.0, 0.0, 10.0),
+            direction: Vec3::NEG_Z,
+            up: Vec3::Y,
+            size: 4.0,
+        });
+        let r = c.ray_at(1.0, 0.5);
+        assert!((r.origin - Vec3::new(2.0, 0.0, 10.0)).length() < 1e-6);
+        assert_eq!(c.t_min(), f32::NEG_INFINITY);
+    }
+}

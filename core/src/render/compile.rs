@@ -1,0 +1,244 @@
+//! The render-ready scene: transforms flattened into one cached matrix set per object (a
+//! Transform chain costs one matrix, never an inversion per ray), materials resolved, and a
+//! top-level BVH over the bounded objects. Meshes are shared, not copied: each mesh is an
+//! instance of its own BVH, entered once per ray in object space.
+
+use std::sync::Arc;
+
+use glam::{Mat3, Mat4, Vec3};
+
+use super::camera::CameraRays;
+use super::NormalTransform;
+use crate::accel::Bvh;
+use crate::geometry::{Aabb, Ray, intersect_plane, intersect_sphere, intersect_triangle, triangle_normal};
+use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, compose};
+
+#[derive(Clone, Debug)]
+pub enum Shape {
+    Sphere { center: Vec3, radius: f32 },
+    /// `normal` is unit length: the plane is {p : normal·p = offset}.
+    Plane { normal: Vec3, offset: f32 },
+    Triangle { vertices: [Vec3; 3], normal: Vec3 },
+    Mesh(Arc<Mesh>),
+}
+
+/// A transform with everything rays and normals need, computed once.
+#[derive(Clone, Copy, Debug)]
+pub struct Xf {
+    pub world_from_object: Mat4,
+    pub object_from_world: Mat4,
+    /// (M⁻¹)ᵀ for normals: M itself skews them under non-uniform scale and shear.
+    pub normal_from_object: Mat3,
+}
+
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub shape: Shape,
+    pub xf: Option<Xf>,
+    /// Index into `CompiledScene::materials` (the last entry is the default material).
+    pub material: u32,
+    pub node: NodeId,
+}
+
+/// The closest hit of a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// World ray parameter.
+    pub t: f32,
+    pub object: u32,
+    /// Triangle index within a mesh (0 otherwise).
+    pub prim: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct CompiledScene {
+    pub camera: CameraRays,
+    pub background: Vec3,
+    pub ambient: Vec3,
+    /// (direction toward the light, normalised; colour)
+    pub lights: Vec<(Vec3, Vec3)>,
+    pub materials: Vec<Vec3>,
+    pub objects: Vec<Object>,
+    bvh: Bvh,
+    /// Objects with no finite bounds (planes), tested for every ray.
+    unbounded: Vec<u32>,
+}
+
+impl CompiledScene {
+    pub fn new(scene: &Scene) -> Self {
+        let mut materials: Vec<Vec3> = scene.materials.iter().map(|m| m.diffuse).collect();
+        let default_material = materials.len() as u32;
+        materials.push(DEFAULT_MATERIAL_COLOR);
+        let n_mat = scene.materials.len() as u32;
+
+        let g = &scene.graph;
+        let mut objects = Vec::new();
+        // (node, world_from_object, material in effect)
+        let mut stack = vec![(g.root(), Mat4::IDENTITY, None::<u32>)];
+        while let Some((id, m, inherited)) = stack.pop() {
+            let Some(node) = g.get(id) else { continue };
+            let material = node.material.or(inherited);
+            let shape = match &node.kind {
+                NodeKind::Group => {
+                    for &c in node.children.iter().rev() {
+                        stack.push((c, m, material));
+                    }
+                    continue;
+                }
+                NodeKind::Transform(ops) => {
+                    let m = m * compose(ops);
+                    for &c in node.children.iter().rev() {
+                        stack.push((c, m, material));
+                    }
+                    continue;
+                }
+                NodeKind::Sphere { center, radius } => Shape::Sphere { center: *center, radius: *radius },
+                NodeKind::Plane { normal, offset } => {
+                    // The offset is measured along the normalised normal, as the course's
+                    // Plane does.
+                    Shape::Plane { normal: normal.normalize_or(Vec3::Y), offset: *offset }
+                }
+                NodeKind::Triangle { vertices: [a, b, c] } => {
+                    Shape::Triangle { vertices: [*a, *b, *c], normal: triangle_normal(*a, *b, *c) }
+                }
+                NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. } => Shape::Mesh(mesh.clone()),
+                NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_), .. } => continue,
+            };
+            let xf = (m != Mat4::IDENTITY).then(|| {
+                let inv = m.inverse();
+                Xf { world_from_object: m, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
+            });
+            let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
+            objects.push(Object { shape, xf, material, node: id });
+        }
+
+        let mut bounded_boxes = Vec::new();
+        let mut bounded_ids = Vec::new();
+        let mut unbounded = Vec::new();
+        for (i, o) in objects.iter().enumerate() {
+            let b = object_bounds(o);
+            if b.is_finite() && !b.is_empty() {
+                bounded_boxes.push(b);
+                bounded_ids.push(i as u32);
+            } else if !b.is_empty() {
+                unbounded.push(i as u32);
+            }
+        }
+        let mut bvh = Bvh::build(&bounded_boxes);
+        // The BVH indexes `bounded_boxes`; point it at object ids instead.
+        for p in &mut bvh.indices {
+            *p = bounded_ids[*p as usize];
+        }
+
+        let lights = scene
+            .lights()
+            .iter()
+            .map(|l| (-l.direction.normalize_or(Vec3::NEG_Z), l.color))
+            .collect();
+        CompiledScene {
+            camera: CameraRays::new(&scene.camera),
+            background: scene.background_color(),
+            ambient: scene.effective_ambient(),
+            lights,
+            materials,
+            objects,
+            bvh,
+            unbounded,
+        }
+    }
+
+    /// The closest hit with t in (t_min, t_max).
+    pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_best = t_max;
+        for &i in &self.unbounded {
+            if let Some((t, prim)) = self.intersect_object(i, ray, t_min, t_best) {
+                t_best = t;
+                best = Some(Hit { t, object: i, prim });
+            }
+        }
+        self.bvh.traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
+            let (t, prim) = self.intersect_object(i, ray, t_min, t_max)?;
+            best = Some(Hit { t, object: i, prim });
+            Some(t)
+        });
+        best
+    }
+
+    /// One object's closest hit: (t, triangle index).
+    #[inline]
+    pub fn intersect_object(&self, i: u32, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
+        let o = self.objects.get(i as usize)?;
+        let local;
+        let r = match &o.xf {
+            // Direction deliberately not renormalised: t is the same in both spaces.
+            Some(xf) => {
+                local = ray.transformed(&xf.object_from_world);
+                &local
+            }
+            None => ray,
+        };
+        match &o.shape {
+            Shape::Sphere { center, radius } => intersect_sphere(r, *center, *radius, t_min, t_max).map(|t| (t, 0)),
+            Shape::Plane { normal, offset } => intersect_plane(r, *normal, *offset, t_min, t_max).map(|t| (t, 0)),
+            Shape::Triangle { vertices: [a, b, c], .. } => {
+                intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0))
+            }
+            Shape::Mesh(m) => m.accel.intersect(r, t_min, t_max).map(|h| (h.t, h.triangle)),
+        }
+    }
+
+    /// The object-space normal at a hit (not normalised for spheres' scale; unit otherwise).
+    pub fn object_normal(&self, ray: &Ray, hit: &Hit) -> Vec3 {
+        let Some(o) = self.objects.get(hit.object as usize) else { return Vec3::Z };
+        match &o.shape {
+            Shape::Sphere { center, .. } => {
+                let r = match &o.xf {
+                    Some(xf) => ray.transformed(&xf.object_from_world),
+                    None => *ray,
+                };
+                (r.at(hit.t) - *center).normalize_or(Vec3::Z)
+            }
+            Shape::Plane { normal, .. } => *normal,
+            Shape::Triangle { normal, .. } => *normal,
+            Shape::Mesh(m) => m.face_normal(hit.prim),
+        }
+    }
+
+    /// The world normal at a hit, normalised, by the chosen rule.
+    pub fn world_normal(&self, ray: &Ray, hit: &Hit, mode: NormalTransform) -> Vec3 {
+        let n = self.object_normal(ray, hit);
+        match self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()) {
+            None => n,
+            Some(xf) => match mode {
+                NormalTransform::Correct => (xf.normal_from_object * n).normalize_or(n),
+                NormalTransform::Incorrect => xf.world_from_object.transform_vector3(n).normalize_or(n),
+            },
+        }
+    }
+
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    pub fn material_color(&self, object: u32) -> Vec3 {
+        self.objects
+            .get(object as usize)
+            .and_then(|o| self.materials.get(o.material as usize))
+            .copied()
+            .unwrap_or(DEFAULT_MATERIAL_COLOR)
+    }
+}
+
+fn object_bounds(o: &Object) -> Aabb {
+    let local = match &o.shape {
+        Shape::Sphere { center, radius } => Aabb::new(*center - Vec3::splat(radius.abs()), *center + Vec3::splat(radius.abs())),
+        Shape::Plane { .. } => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+        Shape::Triangle { vertices, .. } => Aabb::from_points(vertices),
+        Shape::Mesh(m) => m.bounds(),
+    };
+    match &o.xf {
+        Some(xf) if local.is_finite() => local.transformed(&xf.world_from_object),
+        _ => local,
+    }
+}

@@ -1,0 +1,106 @@
+//! The result of a render: per pixel, the quantised colour and normal views, the hit t (the
+//! depth view is made from it for any range) and the node hit (for picking).
+
+use glam::Vec3;
+
+/// One pixel's results.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    pub color: [u8; 3],
+    pub normal: [u8; 3],
+    /// World ray parameter of the hit; `f32::INFINITY` for a miss.
+    pub t: f32,
+    /// Raw `NodeId` of the object hit; `u32::MAX` for a miss.
+    pub node: u32,
+}
+
+impl Sample {
+    pub const UNSET: Sample = Sample { color: [0; 3], normal: [0; 3], t: f32::INFINITY, node: u32::MAX };
+    pub fn is_hit(&self) -> bool {
+        self.node != u32::MAX
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum View {
+    Color,
+    Normals,
+    Depth,
+}
+
+/// Pixels stored in image order: row 0 is the top of the picture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub samples: Vec<Sample>,
+}
+
+/// The course's quantiser: byte = clamp(⌊c·255⌋, 0, 255).
+#[inline]
+pub fn quantize(c: f32) -> u8 {
+    (c * 255.0).clamp(0.0, 255.0) as u8
+}
+
+/// Depth view shade: (max − t)/(max − min) clamped to [0, 1]; t < min is white, t > max black.
+#[inline]
+pub fn depth_shade(t: f32, min: f32, max: f32) -> f32 {
+    if max == min {
+        return if t <= min { 1.0 } else { 0.0 };
+    }
+    ((max - t) / (max - min)).clamp(0.0, 1.0)
+}
+
+impl Frame {
+    pub fn new(width: u32, height: u32) -> Self {
+        Frame { width, height, samples: vec![Sample::UNSET; width as usize * height as usize] }
+    }
+
+    pub fn get(&self, x: u32, row: u32) -> Option<&Sample> {
+        if x >= self.width || row >= self.height {
+            return None;
+        }
+        self.samples.get(row as usize * self.width as usize + x as usize)
+    }
+
+    /// RGB8 bytes of one view, rows top to bottom. `depth` is (min, max) for the depth view.
+    pub fn rgb8(&self, view: View, depth: (f32, f32)) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.samples.len() * 3);
+        for s in &self.samples {
+            match view {
+                View::Color => out.extend_from_slice(&s.color),
+                View::Normals => out.extend_from_slice(&s.normal),
+                View::Depth => {
+                    let g = if s.is_hit() { quantize(depth_shade(s.t, depth.0, depth.1)) } else { 0 };
+                    out.extend_from_slice(&[g, g, g]);
+                }
+            }
+        }
+        out
+    }
+
+    /// RGBA8 bytes (opaque) of one view, for textures.
+    pub fn rgba8(&self, view: View, depth: (f32, f32)) -> Vec<u8> {
+        let rgb = self.rgb8(view, depth);
+        let mut out = Vec::with_capacity(rgb.len() / 3 * 4);
+        for p in rgb.chunks_exact(3) {
+            out.extend_from_slice(&[p[0], p[1], p[2], 255]);
+        }
+        out
+    }
+
+    pub fn save(&self, view: View, depth: (f32, f32), path: &std::path::Path) -> Result<(), image::ImageError> {
+        let img = image::RgbImage::from_raw(self.width, self.height, self.rgb8(view, depth))
+            .expect("buffer size matches the frame");
+        img.save(path)
+    }
+}
+
+pub(super) fn sample_from(color: Vec3, normal: Vec3, t: f32, node: u32) -> Sample {
+    Sample {
+        color: [quantize(color.x), quantize(color.y), quantize(color.z)],
+        normal: [quantize(normal.x.abs()), quantize(normal.y.abs()), quantize(normal.z.abs())],
+        t,
+        node,
+    }
+}

@@ -1,0 +1,47 @@
+//! Rendering: camera rays, the compiled (render-ready) scene, shading, the colour, normal
+//! and depth views, and the progressive, cancellable driver.
+
+mod camera;
+mod compile;
+mod frame;
+mod progressive;
+mod shade;
+
+pub use camera::CameraRays;
+pub use compile::{CompiledScene, Hit, Object, Shape};
+pub use frame::{Frame, Sample, View, depth_shade, quantize};
+pub use progressive::{Cancelled, PassInfo, SharedFrame, render_frame, render_full, render_progressive};
+pub use shade::{LightTerm, ShadeInfo, shade_hit};
+
+/// How world normals are obtained from object-space ones under a Transform.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum NormalTransform {
+    /// (M⁻¹)ᵀ · n, normalised: stays perpendicular to the surface under any affine M.
+    #[default]
+    Correct,
+    /// M · n, normalised: the lecture's "incorrect normal transformation"; wrong under
+    /// non-uniform scale and shear, right for rotations and uniform scale.
+    Incorrect,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Flip back-facing normals toward the eye before shading (`-shade_back`); without it a
+    /// back-facing hit is black.
+    pub shade_back: bool,
+    pub normal_transform: NormalTransform,
+}
+
+impl RenderSettings {
+    pub fn new(width: u32, height: u32) -> Self {
+        RenderSettings { width, height, shade_back: false, normal_transform: NormalTransform::Correct }
+    }
+}
+
+/// Compiles a scene for rendering (flattens transforms, resolves materials, builds the
+/// top-level BVH).
+pub fn compile(scene: &crate::Scene) -> CompiledScene {
+    CompiledScene::new(scene)
+}

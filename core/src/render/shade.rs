@@ -1,0 +1,83 @@
+//! Diffuse shading as the lecture defines it:
+//! c = c_ambient·k_d + Σ max(L·N, 0)·c_light·k_d. No shadows (assignment 2).
+
+use glam::Vec3;
+
+use super::compile::{CompiledScene, Hit};
+use super::RenderSettings;
+use crate::geometry::Ray;
+
+/// One light's share of a pixel, for the pixel inspector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightTerm {
+    /// Direction toward the light (normalised).
+    pub l: Vec3,
+    pub l_dot_n: f32,
+    pub contribution: Vec3,
+}
+
+/// Everything that went into a hit's colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadeInfo {
+    /// World normal by the chosen rule, before any shade-back flip (what the normal view shows).
+    pub normal: Vec3,
+    /// The normal used for shading (flipped toward the eye under shade-back).
+    pub shading_normal: Vec3,
+    pub back_facing: bool,
+    pub diffuse: Vec3,
+    pub ambient_term: Vec3,
+    pub lights: Vec<LightTerm>,
+    pub color: Vec3,
+}
+
+pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> ShadeInfo {
+    let normal = scene.world_normal(ray, hit, settings.normal_transform);
+    let kd = scene.material_color(hit.object);
+    let back_facing = ray.direction.dot(normal) > 0.0;
+    let mut info = ShadeInfo {
+        normal,
+        shading_normal: normal,
+        back_facing,
+        diffuse: kd,
+        ambient_term: Vec3::ZERO,
+        lights: Vec::new(),
+        color: Vec3::ZERO,
+    };
+    if back_facing {
+        if !settings.shade_back {
+            // The course's sample images draw back faces black without -shade_back.
+            return info;
+        }
+        info.shading_normal = -normal;
+    }
+    let n = info.shading_normal;
+    info.ambient_term = scene.ambient * kd;
+    let mut c = info.ambient_term;
+    for &(l, color) in &scene.lights {
+        let d = l.dot(n);
+        let contribution = d.max(0.0) * color * kd;
+        c += contribution;
+        info.lights.push(LightTerm { l, l_dot_n: d, contribution });
+    }
+    info.color = c;
+    info
+}
+
+/// Colour only, without collecting terms (the hot path).
+#[inline]
+pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> (Vec3, Vec3) {
+    let normal = scene.world_normal(ray, hit, settings.normal_transform);
+    let kd = scene.material_color(hit.object);
+    let mut n = normal;
+    if ray.direction.dot(normal) > 0.0 {
+        if !settings.shade_back {
+            return (Vec3::ZERO, normal);
+        }
+        n = -normal;
+    }
+    let mut c = scene.ambient * kd;
+    for &(l, color) in &scene.lights {
+        c += l.dot(n).max(0.0) * color * kd;
+    }
+    (c, normal)
+}

@@ -1,0 +1,234 @@
+//! The object graph as an arena: nodes live in one `Vec` and refer to their children by id.
+//! An arena keeps drop, clone, comparison and every walk iterative, so a file with tens of
+//! thousands of nested Groups cannot overflow the stack, and ids give the GUI stable handles.
+
+use glam::Vec3;
+
+use super::{MeshSlot, TransformOp};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);
+
+impl NodeId {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum NodeKind {
+    Group,
+    /// Ops as listed in the file: M = op1 · op2 · … · opn, so the first listed is applied last.
+    Transform(Vec<TransformOp>),
+    Sphere { center: Vec3, radius: f32 },
+    /// Points p with normal · p = offset.
+    Plane { normal: Vec3, offset: f32 },
+    Triangle { vertices: [Vec3; 3] },
+    TriangleMesh { obj_file: String, mesh: MeshSlot },
+}
+
+impl NodeKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            NodeKind::Group => "Group",
+            NodeKind::Transform(_) => "Transform",
+            NodeKind::Sphere { .. } => "Sphere",
+            NodeKind::Plane { .. } => "Plane",
+            NodeKind::Triangle { .. } => "Triangle",
+            NodeKind::TriangleMesh { .. } => "TriangleMesh",
+        }
+    }
+
+    /// Whether the node holds other objects (and how many it must hold).
+    pub fn is_container(&self) -> bool {
+        matches!(self, NodeKind::Group | NodeKind::Transform(_))
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    pub kind: NodeKind,
+    /// The material set by a `MaterialIndex` before this node in its Group; `None` inherits
+    /// the material in effect around it.
+    pub material: Option<u32>,
+    pub children: Vec<NodeId>,
+}
+
+impl Node {
+    pub fn new(kind: NodeKind) -> Self {
+        Node { kind, material: None, children: Vec::new() }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    root: NodeId,
+}
+
+impl Default for Graph {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Graph {
+    /// A graph holding one empty root Group.
+    pub fn new() -> Self {
+        Graph { nodes: vec![Node::new(NodeKind::Group)], root: NodeId(0) }
+    }
+
+    pub fn root(&self) -> NodeId {
+        self.root
+    }
+
+    pub fn get(&self, id: NodeId) -> Option<&Node> {
+        self.nodes.get(id.index())
+    }
+
+    pub fn get_mut(&mut self, id: NodeId) -> Option<&mut Node> {
+        self.nodes.get_mut(id.index())
+    }
+
+    /// The node; panics on an id that did not come from this graph.
+    pub fn node(&self, id: NodeId) -> &Node {
+        &self.nodes[id.index()]
+    }
+
+    pub fn node_mut(&mut self, id: NodeId) -> &mut Node {
+        &mut self.nodes[id.index()]
+    }
+
+    /// Adds a detached node; attach it with [`Graph::push_child`] or [`Graph::insert_child`].
+    pub fn add(&mut self, node: Node) -> NodeId {
+        let id = NodeId(u32::try_from(self.nodes.len()).unwrap_or(u32::MAX));
+        self.nodes.push(node);
+        id
+    }
+
+    pub fn push_child(&mut self, parent: NodeId, child: NodeId) {
+        self.nodes[parent.index()].children.push(child);
+    }
+
+    pub fn insert_child(&mut self, parent: NodeId, index: usize, child: NodeId) {
+        let children = &mut self.nodes[parent.index()].children;
+        let index = index.min(children.len());
+        children.insert(index, child);
+    }
+
+    /// Number of slots in the arena, detached nodes included.
+    pub fn capacity_len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Nodes reachable from the root, parents before children, children in order.
+    pub fn preorder(&self) -> Vec<NodeId> {
+        self.preorder_from(self.root)
+    }
+
+    pub fn preorder_from(&self, start: NodeId) -> Vec<NodeId> {
+        let mut out = Vec::new();
+        let mut stack = vec![start];
+        while let Some(id) = stack.pop() {
+            out.push(id);
+            if let Some(n) = self.get(id) {
+                stack.extend(n.children.iter().rev().copied());
+            }
+        }
+        out
+    }
+
+    /// Parent of every reachable node (the root has none).
+    pub fn parents(&self) -> Vec<Option<NodeId>> {
+        let mut parents = vec![None; self.nodes.len()];
+        for id in self.preorder() {
+            for &c in &self.node(id).children {
+                if let Some(p) = parents.get_mut(c.index()) {
+                    *p = Some(id);
+                }
+            }
+        }
+        parents
+    }
+
+    /// The ids from the root down to `target` (inclusive), or `None` if it is not reachable.
+    pub fn path_to(&self, target: NodeId) -> Option<Vec<NodeId>> {
+        let parents = self.parents();
+        let mut path = vec![target];
+        let mut cur = target;
+        while cur != self.root {
+            cur = (*parents.get(cur.index())?)?;
+            path.push(cur);
+        }
+        path.reverse();
+        Some(path)
+    }
+
+    /// The material each reachable node renders with (`None`: the default material).
+    pub fn effective_materials(&self) -> Vec<Option<u32>> {
+        let mut out = vec![None; self.nodes.len()];
+        let mut stack = vec![(self.root, None::<u32>)];
+        while let Some((id, inherited)) = stack.pop() {
+            let node = self.node(id);
+            let m = node.material.or(inherited);
+            out[id.index()] = m;
+            for &c in node.children.iter().rev() {
+                stack.push((c, m));
+            }
+        }
+        out
+    }
+
+    /// A copy holding only the nodes reachable from the root, renumbered in preorder. Two
+    /// graphs describing the same tree compact to equal values.
+    pub fn compacted(&self) -> Graph {
+        let order = self.preorder();
+        let mut new_id = vec![u32::MAX; self.nodes.len()];
+        for (i, id) in order.iter().enumerate() {
+            new_id[id.index()] = i as u32;
+        }
+        let nodes = order
+            .iter()
+            .map(|&id| {
+                let n = self.node(id);
+                Node {
+                    kind: n.kind.clone(),
+                    material: n.material,
+                    children: n.children.iter().map(|c| NodeId(new_id[c.index()])).collect(),
+                }
+            })
+            .collect();
+        Graph { nodes, root: NodeId(0) }
+    }
+
+    /// Iterates over all reachable nodes with their ids.
+    pub fn iter(&self) -> impl Iterator<Item = (NodeId, &Node)> {
+        self.preorder().into_iter().map(move |id| (id, self.node(id)))
+    }
+
+    /// Counts of reachable objects and triangles, for status bars.
+    pub fn stats(&self) -> GraphStats {
+        let mut s = GraphStats::default();
+        for (_, n) in self.iter() {
+            s.nodes += 1;
+            match &n.kind {
+                NodeKind::Triangle { .. } => s.triangles += 1,
+                NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(m), .. } => {
+                    s.triangles += m.triangle_count()
+                }
+                _ => {}
+            }
+            if !n.kind.is_container() {
+                s.primitives += 1;
+            }
+        }
+        s
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GraphStats {
+    pub nodes: usize,
+    pub primitives: usize,
+    pub triangles: usize,
+}

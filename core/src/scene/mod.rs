@@ -1,0 +1,132 @@
+//! The in-memory scene: camera, lights, background, materials and the object graph.
+//! Plain data: the parser builds it, the writer prints it, the GUI edits it, the renderer
+//! compiles a snapshot of it.
+
+mod graph;
+mod mesh;
+mod transform;
+
+pub use graph::{Graph, Node, NodeId, NodeKind};
+pub use mesh::{Mesh, MeshSlot};
+pub use transform::{TransformOp, compose};
+
+use glam::Vec3;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Camera {
+    Orthographic { center: Vec3, direction: Vec3, up: Vec3, size: f32 },
+    /// `angle` is the full field of view in degrees.
+    Perspective { center: Vec3, direction: Vec3, up: Vec3, angle: f32 },
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera::Perspective {
+            center: Vec3::new(0.0, 0.0, 10.0),
+            direction: Vec3::NEG_Z,
+            up: Vec3::Y,
+            angle: 30.0,
+        }
+    }
+}
+
+impl Camera {
+    pub fn center(&self) -> Vec3 {
+        match self {
+            Camera::Orthographic { center, .. } | Camera::Perspective { center, .. } => *center,
+        }
+    }
+    pub fn direction(&self) -> Vec3 {
+        match self {
+            Camera::Orthographic { direction, .. } | Camera::Perspective { direction, .. } => {
+                *direction
+            }
+        }
+    }
+    pub fn up(&self) -> Vec3 {
+        match self {
+            Camera::Orthographic { up, .. } | Camera::Perspective { up, .. } => *up,
+        }
+    }
+}
+
+/// A directional light: `direction` points from the light into the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub direction: Vec3,
+    pub color: Vec3,
+}
+
+/// `Background { color ambientLight }`; either field may be absent in a file, and absent
+/// fields are kept absent so a round trip writes the same text.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Background {
+    pub color: Option<Vec3>,
+    pub ambient: Option<Vec3>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialKeyword {
+    /// `Material { diffuseColor ... }` (assignment 2)
+    Material,
+    /// `PhongMaterial { diffuseColor ... }` (assignment 1 files)
+    PhongMaterial,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub diffuse: Vec3,
+    pub keyword: MaterialKeyword,
+    /// Fields tracelab does not shade with (specularColor, exponent, ...), kept for the writer.
+    pub extra: Vec<(String, Vec<f32>)>,
+}
+
+impl Material {
+    pub fn diffuse(diffuse: Vec3) -> Self {
+        Material { diffuse, keyword: MaterialKeyword::Material, extra: Vec::new() }
+    }
+}
+
+/// What objects render with when no `MaterialIndex` applies to them.
+pub const DEFAULT_MATERIAL_COLOR: Vec3 = Vec3::new(0.8, 0.8, 0.8);
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub camera: Camera,
+    /// `None` when the file has no `Lights` block: then the scene is shown flat in its
+    /// diffuse colours (ambient 1), as the course's assignment 1 does.
+    pub lights: Option<Vec<Light>>,
+    pub background: Background,
+    pub materials: Vec<Material>,
+    pub graph: Graph,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            camera: Camera::default(),
+            lights: Some(Vec::new()),
+            background: Background::default(),
+            materials: Vec::new(),
+            graph: Graph::new(),
+        }
+    }
+}
+
+impl Scene {
+    pub fn background_color(&self) -> Vec3 {
+        self.background.color.unwrap_or(Vec3::ZERO)
+    }
+
+    /// The ambient light shading uses: (1,1,1) without a Lights block (assignment-1 flat look).
+    pub fn effective_ambient(&self) -> Vec3 {
+        match self.lights {
+            None => Vec3::ONE,
+            Some(_) => self.background.ambient.unwrap_or(Vec3::ZERO),
+        }
+    }
+
+    pub fn lights(&self) -> &[Light] {
+        self.lights.as_deref().unwrap_or(&[])
+    }
+}
