@@ -117,12 +117,14 @@ pub struct RenderJob {
 pub enum CliError {
     Usage(String),
     Failed(String),
+    /// A usage error already printed (by clap).
+    UsagePrinted,
 }
 
 impl CliError {
     fn code(&self) -> ExitCode {
         match self {
-            CliError::Usage(_) => ExitCode::from(2),
+            CliError::Usage(_) | CliError::UsagePrinted => ExitCode::from(2),
             CliError::Failed(_) => ExitCode::from(1),
         }
     }
@@ -137,6 +139,7 @@ pub fn main() -> ExitCode {
             match &e {
                 CliError::Usage(m) => eprintln!("tracelab: {m}\nTry 'tracelab --help'."),
                 CliError::Failed(m) => eprint!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }),
+                CliError::UsagePrinted => {}
             }
             e.code()
         }
@@ -156,7 +159,7 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
             let _ = e.print();
             return match e.kind() {
                 clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => Ok(()),
-                _ => Err(CliError::Usage(String::new())).map_err(|_| CliError::Usage("invalid arguments".into())),
+                _ => Err(CliError::UsagePrinted),
             };
         }
     };

@@ -84,6 +84,8 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         base_dir,
         cache,
         camera: None,
+        camera_seen: false,
+        group_seen: false,
         lights: None,
         background: None,
         materials: Vec::new(),
@@ -105,6 +107,9 @@ struct Parser<'a> {
     base_dir: Option<&'a Path>,
     cache: &'a mut MeshCache,
     camera: Option<Camera>,
+    /// A camera or object Group block was present (even if broken): do not also report it missing.
+    camera_seen: bool,
+    group_seen: bool,
     lights: Option<Vec<Light>>,
     background: Option<Background>,
     materials: Vec<Material>,
@@ -370,6 +375,11 @@ impl<'a> Parser<'a> {
         if f.values.len() < n {
             let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
             let (found, off) = f.after.clone();
+            // The word found instead of a number is not a field of its own: do not report
+            // it again as unknown.
+            if let Some(next) = fields.get_mut(i + 1).filter(|g| g.name_off == off) {
+                next.used = true;
+            }
             self.error(off, format!("expected {what} after \"{name}\", found {found}"));
             return None;
         }
@@ -418,11 +428,17 @@ impl<'a> Parser<'a> {
                 TokKind::Word => {
                     let kw = self.text(t);
                     match kw {
-                        "OrthographicCamera" | "PerspectiveCamera" => self.parse_camera(kw, t.start),
+                        "OrthographicCamera" | "PerspectiveCamera" => {
+                            self.camera_seen = true;
+                            self.parse_camera(kw, t.start)
+                        }
                         "Lights" => self.parse_lights(t.start),
                         "Background" => self.parse_background(t.start),
                         "Materials" => self.parse_materials(t.start),
-                        "Group" => self.parse_object_tree(t.start),
+                        "Group" => {
+                            self.group_seen = true;
+                            self.parse_object_tree(t.start)
+                        }
                         _ => {
                             let hint = if OBJECT_KEYWORDS.contains(&kw) {
                                 " (objects belong inside the top-level Group)"
@@ -676,6 +692,11 @@ impl<'a> Parser<'a> {
                                         }
                                     }
                                     _ => {
+                                        // A misspelt object still counts toward numObjects,
+                                        // so one typo gives one error.
+                                        if self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                                            *count += 1;
+                                        }
                                         self.error(
                                             t.start,
                                             format!(
@@ -901,10 +922,10 @@ impl<'a> Parser<'a> {
                 self.error(at, format!("MaterialIndex {i} is out of range: {range}"));
             }
         }
-        if self.camera.is_none() {
+        if self.camera.is_none() && !self.camera_seen {
             self.error(end, "the scene has no camera (OrthographicCamera or PerspectiveCamera)");
         }
-        if self.graph.is_none() {
+        if self.graph.is_none() && !self.group_seen {
             self.error(end, "the scene has no Group of objects");
         }
         if let Some(graph) = &self.graph {

@@ -8,6 +8,13 @@ use glam::Vec3;
 use crate::scene::{Camera, Graph, MaterialKeyword, NodeId, NodeKind, Scene, TransformOp};
 
 const IND: &str = "    ";
+/// Indentation stops growing past this depth, so a file with tens of thousands of nested
+/// Groups is written in linear, not quadratic, space.
+const MAX_INDENT_DEPTH: usize = 32;
+
+fn indent(depth: usize) -> String {
+    IND.repeat(depth.min(MAX_INDENT_DEPTH))
+}
 
 fn num(x: f32) -> String {
     // `{}` on f32 prints the shortest text that parses back to the same value. Avoid "-0".
@@ -129,13 +136,13 @@ fn write_graph(out: &mut String, graph: &Graph) {
         // there; wrap the node in a one-object Group that sets it.
         if !in_group && id != graph.root() {
             if let Some(m) = node.material {
-                let ind = IND.repeat(depth);
+                let ind = indent(depth);
                 let _ = writeln!(out, "{ind}Group {{\n{ind}{IND}numObjects 1\n{ind}{IND}MaterialIndex {m}");
                 closers.push(format!("{ind}}}\n"));
                 depth += 1;
             }
         }
-        let ind = IND.repeat(depth);
+        let ind = indent(depth);
         let inner = format!("{ind}{IND}");
         let _ = writeln!(out, "{ind}{} {{", node.kind.name());
         match &node.kind {
