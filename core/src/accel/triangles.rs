@@ -14,6 +14,30 @@ struct Tri {
     e2: Vec3,
 }
 
+impl Tri {
+    /// Two-sided Möller–Trumbore: the ray parameter of a hit, if any.
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3) -> Option<f32> {
+        let p = d.cross(self.e2);
+        let det = self.e1.dot(p);
+        if det == 0.0 {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let s = o - self.v0;
+        let u = s.dot(p) * inv_det;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(self.e1);
+        let v = d.dot(q) * inv_det;
+        if v < 0.0 || u + v > 1.0 {
+            return None;
+        }
+        Some(self.e2.dot(q) * inv_det)
+    }
+}
+
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleBvh {
     bvh: Bvh,
@@ -48,8 +72,44 @@ impl TriangleBvh {
         TriangleBvh { bvh, tris }
     }
 
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
+    /// Checks the BVH invariants against the mesh it was built from (for tests): every
+    /// triangle in exactly one leaf, children inside their parents' bounds.
+    pub fn check_invariants(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), String> {
+        let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+        let bounds: Vec<Aabb> =
+            triangles.iter().map(|t| Aabb::EMPTY.grow(vert(t[0])).grow(vert(t[1])).grow(vert(t[2]))).collect();
+        self.bvh.check_invariants(&bounds)
+    }
+
+    /// Every hit with t in (t_min, t_max), in no particular order, appended to `out`. CSG
+    /// needs all crossings of a closed mesh along a ray, not just the nearest.
+    pub fn intersect_all(&self, ray: &Ray, t_min: f32, t_max: f32, out: &mut Vec<TriangleHit>) {
+        let nodes = &self.bvh.nodes;
+        if nodes.is_empty() {
+            return;
+        }
+        let (o, d) = (ray.origin, ray.direction);
+        let inv = d.recip();
+        let mut stack = vec![0usize];
+        while let Some(idx) = stack.pop() {
+            let node = &nodes[idx];
+            if node.bounds().hit(o, inv, t_min, t_max).is_none() {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.right_or_first as usize;
+                for k in first..first + node.count as usize {
+                    if let Some(t) = self.tris[k].hit(o, d) {
+                        if t > t_min && t < t_max {
+                            out.push(TriangleHit { t, triangle: self.bvh.indices[k] });
+                        }
+                    }
+                }
+            } else {
+                stack.push(idx + 1);
+                stack.push(node.right_or_first as usize);
+            }
+        }
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -198,11 +258,7 @@ mod tests {
         for (n, seed) in [(1, 7), (50, 11), (2000, 13)] {
             let (pos, tris) = random_mesh(n, seed);
             let bvh = TriangleBvh::build(&pos, &tris);
-            let bounds: Vec<Aabb> = tris
-                .iter()
-                .map(|t| Aabb::from_points(&[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]))
-                .collect();
-            bvh.bvh().check_invariants(&bounds).expect("invariants");
+            bvh.check_invariants(&pos, &tris).expect("invariants");
             let mut s = 99u32;
             let mut rnd = || {
                 s ^= s << 13;
@@ -228,6 +284,29 @@ mod tests {
                     _ => panic!("bvh {a:?} vs brute {b:?}"),
                 }
             }
+        }
+    }
+
+    #[test]
+    fn intersect_all_finds_every_crossing() {
+        let (pos, tris) = random_mesh(500, 5);
+        let bvh = TriangleBvh::build(&pos, &tris);
+        let mut out = Vec::new();
+        for k in 0..200 {
+            let o = Vec3::new(-5.0, (k as f32 * 0.37).sin() * 1.5, (k as f32 * 0.11).cos() * 1.5);
+            let ray = Ray::new(o, Vec3::new(1.0, 0.01 * k as f32 - 1.0, 0.3));
+            out.clear();
+            bvh.intersect_all(&ray, 0.0, f32::INFINITY, &mut out);
+            let mut got: Vec<u32> = out.iter().map(|h| h.triangle).collect();
+            got.sort_unstable();
+            let want: Vec<u32> = (0..tris.len() as u32)
+                .filter(|&i| {
+                    let t = tris[i as usize];
+                    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+                    intersect_triangle(&ray, a, b, c, 0.0, f32::INFINITY).is_some()
+                })
+                .collect();
+            assert_eq!(got, want, "ray {k}");
         }
     }
 
