@@ -219,3 +219,24 @@ fn deeply_nested_csg_neither_overflows_nor_fails() {
     let hit = scene.intersect(&ray, 0.0, f32::INFINITY).expect("the union is hit");
     assert!((hit.t - 9.0).abs() < 1e-5, "{}", hit.t);
 }
+
+#[test]
+fn transform_ops_in_braces_read_as_on_the_slides_and_are_written_bare() {
+    let braced = parse_ok(&format!(
+        "{HEAD}Group {{\n numObjects 1\n MaterialIndex 0\n Transform {{\n  ZRotate {{ 45 }}\n  Translate {{ -2 0 0 }}\n  Scale {{ 1 2 3 }}\n  Sphere {{ center 0 0 0 radius 1 }}\n }}\n}}\n"
+    ));
+    let bare = parse_ok(&format!(
+        "{HEAD}Group {{\n numObjects 1\n MaterialIndex 0\n Transform {{\n  ZRotate 45\n  Translate -2 0 0\n  Scale 1 2 3\n  Sphere {{ center 0 0 0 radius 1 }}\n }}\n}}\n"
+    ));
+    assert_eq!(braced, bare);
+    let text = write_scene(&braced);
+    assert!(text.contains("ZRotate 45\n") && text.contains("Translate -2 0 0\n"), "{text}");
+    let e = errors(
+        "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  Translate { -2 0 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
+    );
+    assert_eq!(e, ["5:20: expected 3 numbers after \"Translate\", found \"}\""]);
+    let e = errors(
+        "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  ZRotate { 45 1 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
+    );
+    assert_eq!(e, ["5:16: expected \"}\" to close ZRotate after 1 number(s), found \"1\""]);
+}

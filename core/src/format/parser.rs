@@ -799,17 +799,41 @@ impl<'a> Parser<'a> {
         }
     }
 
+    /// An op's numbers, bare as the course writes them or in braces as the lecture's slides
+    /// do (`ZRotate { 45 }`); the writer always writes them bare.
+    fn op_numbers(&mut self, w: &str, n: usize) -> Option<Vec<f32>> {
+        if !self.peek().is_some_and(|t| t.kind == TokKind::Open) {
+            return self.expect_numbers(w, n);
+        }
+        self.pos += 1;
+        let v = self.expect_numbers(w, n);
+        match self.peek() {
+            Some(c) if c.kind == TokKind::Close && v.is_some() => {
+                self.pos += 1;
+                v
+            }
+            other => {
+                if v.is_some() {
+                    let (found, at) = self.describe(other);
+                    self.error(at, format!("expected \"}}\" to close {w} after {n} number(s), found {found}"));
+                }
+                self.skip_block();
+                None
+            }
+        }
+    }
+
     /// Parses a transform op after its keyword. Reports and returns None on failure
     /// (including an unknown keyword).
     fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
         let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
         Some(match w {
-            "Scale" => TransformOp::Scale(v3(self.expect_numbers(w, 3)?)),
-            "UniformScale" => TransformOp::UniformScale(self.expect_numbers(w, 1)?[0]),
-            "Translate" => TransformOp::Translate(v3(self.expect_numbers(w, 3)?)),
-            "XRotate" => TransformOp::XRotate(self.expect_numbers(w, 1)?[0]),
-            "YRotate" => TransformOp::YRotate(self.expect_numbers(w, 1)?[0]),
-            "ZRotate" => TransformOp::ZRotate(self.expect_numbers(w, 1)?[0]),
+            "Scale" => TransformOp::Scale(v3(self.op_numbers(w, 3)?)),
+            "UniformScale" => TransformOp::UniformScale(self.op_numbers(w, 1)?[0]),
+            "Translate" => TransformOp::Translate(v3(self.op_numbers(w, 3)?)),
+            "XRotate" => TransformOp::XRotate(self.op_numbers(w, 1)?[0]),
+            "YRotate" => TransformOp::YRotate(self.op_numbers(w, 1)?[0]),
+            "ZRotate" => TransformOp::ZRotate(self.op_numbers(w, 1)?[0]),
             "Rotate" | "Matrix" => {
                 self.expect_open(w)?;
                 let n = if w == "Rotate" { 4 } else { 16 };
