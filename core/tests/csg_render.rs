@@ -317,3 +317,37 @@ fn csg_bounds_follow_the_operation() {
     let c = compile(&scene(&csg("Intersection", A, far)));
     assert!(c.intersect(&Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z), 0.0, f32::INFINITY).is_none());
 }
+
+#[test]
+fn normal_transform_mode_applies_to_csg_surfaces() {
+    let sheared = format!(
+        "Transform {{ Matrix {{ 1 0.7 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }} Scale 1 0.5 1 {} }}",
+        csg("Subtraction", A, B)
+    );
+    let s = scene(&sheared);
+    let at = |mode| {
+        render_frame(&compile(&s), &RenderSettings { width: 64, height: 48, shade_back: false, normal_transform: mode })
+    };
+    let (correct, incorrect) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));
+    assert!(hits(&correct) > 300);
+    // Same geometry, different normals.
+    assert!(correct.samples.iter().zip(&incorrect.samples).all(|(x, y)| x.t.to_bits() == y.t.to_bits()));
+    let differing = correct.samples.iter().zip(&incorrect.samples).filter(|(x, y)| x.normal != y.normal).count();
+    assert!(differing > 100, "only {differing} normals differ");
+    // A similitude (rotation, uniform scale) changes nothing.
+    let similar = scene(&format!("Transform {{ ZRotate 30 UniformScale 1.5 {} }}", csg("Subtraction", A, B)));
+    let at = |mode| {
+        render_frame(
+            &compile(&similar),
+            &RenderSettings { width: 64, height: 48, shade_back: false, normal_transform: mode },
+        )
+    };
+    let (a, b) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));
+    let worst = a
+        .samples
+        .iter()
+        .zip(&b.samples)
+        .flat_map(|(x, y)| (0..3).map(move |c| x.normal[c].abs_diff(y.normal[c])))
+        .max();
+    assert!(worst.unwrap_or(0) <= 1, "similitudes must not change normals ({worst:?})");
+}

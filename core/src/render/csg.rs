@@ -389,10 +389,11 @@ fn leaf_bounds(solid: &Solid, r: &Ray, leaf: u32, out: &mut Vec<Bound>, hits: &m
             let mut last: Option<(f32, bool)> = None;
             for h in hits.iter() {
                 let f = facing(h);
-                if let Some((t, lf)) = last {
-                    if lf == f && (h.t - t).abs() <= 1e-6 * t.abs().max(1.0) {
-                        continue;
-                    }
+                if let Some((t, lf)) = last
+                    && lf == f
+                    && (h.t - t).abs() <= 1e-6 * t.abs().max(1.0)
+                {
+                    continue;
                 }
                 last = Some((h.t, f));
                 kept.push(h.t);
