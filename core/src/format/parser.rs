@@ -3,6 +3,7 @@
 //! collected, not thrown: after an error the parser skips to the end of the enclosing block
 //! and carries on, so one pass reports as many problems as it can.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
@@ -93,7 +94,7 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         material_refs: Vec::new(),
         leaf_offsets: Vec::new(),
         node_offsets: Vec::new(),
-        closed_meshes: Vec::new(),
+        closed_meshes: HashMap::new(),
     };
     p.parse_file();
     p.finish()
@@ -124,7 +125,7 @@ struct Parser<'a> {
     node_offsets: Vec<usize>,
     /// Closedness already checked, per mesh (by address), so a mesh used many times is
     /// checked once.
-    closed_meshes: Vec<(usize, Result<(), String>)>,
+    closed_meshes: HashMap<usize, Result<(), String>>,
 }
 
 /// One `name value…` line inside a flat block.
@@ -884,37 +885,28 @@ impl<'a> Parser<'a> {
         graph: &mut Graph,
     ) -> Option<Frame> {
         let open = self.expect_open(w)?;
-        let offsets = &mut self.node_offsets;
-        let mut attach = |graph: &mut Graph, kind: NodeKind| {
+        let mut attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind| {
             let id = graph.add(Node { kind, material, children: Vec::new() });
             graph.push_child(parent, id);
-            if offsets.len() <= id.index() {
-                offsets.resize(id.index() + 1, 0);
-            }
-            offsets[id.index()] = off;
+            this.record_offset(id, off);
             id
         };
         if let Some(op) = CsgOp::from_name(w) {
-            let node = attach(graph, NodeKind::Csg(op));
+            let node = attach(self, graph, NodeKind::Csg(op));
             return Some(Frame::Csg { node, op, keyword: off, open, count: 0, material: None });
         }
         match w {
             "Group" => {
-                let node = attach(graph, NodeKind::Group);
+                let node = attach(self, graph, NodeKind::Group);
                 Some(Frame::Group { node, open, declared: None, count: 0, material: None })
             }
             "Transform" => {
-                let node = attach(graph, NodeKind::Transform(Vec::new()));
+                let node = attach(self, graph, NodeKind::Transform(Vec::new()));
                 Some(Frame::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
             }
             _ => {
                 let kind = self.parse_primitive(w, off, open)?;
-                let id = graph.add(Node { kind, material, children: Vec::new() });
-                graph.push_child(parent, id);
-                if self.node_offsets.len() <= id.index() {
-                    self.node_offsets.resize(id.index() + 1, 0);
-                }
-                self.node_offsets[id.index()] = off;
+                let id = attach(self, graph, kind);
                 self.leaf_offsets.push((id, off));
                 None
             }
@@ -1030,6 +1022,13 @@ impl<'a> Parser<'a> {
         }
     }
 
+    fn record_offset(&mut self, id: NodeId, off: usize) {
+        if self.node_offsets.len() <= id.index() {
+            self.node_offsets.resize(id.index() + 1, 0);
+        }
+        self.node_offsets[id.index()] = off;
+    }
+
     /// An operand must bound a solid: follow Transforms down to the object they move.
     fn check_operand(&mut self, graph: &Graph, id: NodeId, op: CsgOp) {
         let mut cur = id;
@@ -1057,14 +1056,7 @@ impl<'a> Parser<'a> {
                 // A mesh that failed to load was reported already.
                 let Some(mesh) = mesh.mesh() else { return };
                 let key = std::sync::Arc::as_ptr(mesh) as usize;
-                let result = match self.closed_meshes.iter().find(|(k, _)| *k == key) {
-                    Some((_, r)) => r.clone(),
-                    None => {
-                        let r = check_closed(mesh);
-                        self.closed_meshes.push((key, r.clone()));
-                        r
-                    }
-                };
+                let result = self.closed_meshes.entry(key).or_insert_with(|| check_closed(mesh)).clone();
                 if let Err(why) = result {
                     self.node_error(
                         at,
