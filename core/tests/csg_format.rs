@@ -240,3 +240,65 @@ fn transform_ops_in_braces_read_as_on_the_slides_and_are_written_bare() {
     );
     assert_eq!(e, ["5:16: expected \"}\" to close ZRotate after 1 number(s), found \"1\""]);
 }
+
+/// Deterministic xorshift, so failures reproduce.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+#[test]
+fn no_mutated_csg_scene_panics_and_clean_ones_round_trip() {
+    let seed = format!(
+        "{HEAD}Group {{ Material {{ diffuseColor 0 1 0 }} Subtraction {{ MaterialIndex 0 Intersection {{ Box {{ min -1 -1 -1 max 1 1 1 }} \
+         Sphere {{ center 0 0 0 radius 1.3 }} }} MaterialIndex 1 Transform {{ ZRotate {{ 30 }} Union {{ Plane {{ normal 0 1 0 offset 2 }} \
+         TriangleMesh {{ obj_file ../assets/cube.obj }} }} }} }} Box {{ min 0 0 0 max 1 1 1 }} }}\n"
+    );
+    let words: Vec<&str> = seed.split_whitespace().collect();
+    let extra =
+        ["{", "}", "Union", "Subtraction", "Box", "min", "max", "Triangle", "Group", "MaterialIndex", "Material", "1"];
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut clean = 0;
+    for _ in 0..2000 {
+        let mut w = words.clone();
+        for _ in 0..1 + rng.below(2) {
+            match rng.below(3) {
+                0 if !w.is_empty() => {
+                    let i = rng.below(w.len());
+                    w.remove(i);
+                }
+                1 => {
+                    let i = rng.below(w.len() + 1);
+                    w.insert(i, extra[rng.below(extra.len())]);
+                }
+                _ if !w.is_empty() => {
+                    let i = rng.below(w.len());
+                    w[i] = words[rng.below(words.len())];
+                }
+                _ => {}
+            }
+        }
+        let text = w.join(" ");
+        let out = parse(&text);
+        let Some(scene) = out.scene else {
+            assert!(out.diagnostics.has_errors(), "no scene and no error for {text}");
+            continue;
+        };
+        let c = tracelab_core::compile(&scene);
+        let _ = tracelab_core::render_frame(&c, &tracelab_core::RenderSettings::new(6, 6));
+        if !out.diagnostics.has_errors() {
+            clean += 1;
+            let (written, back) = round_trip(&scene);
+            assert_eq!(back, scene, "round trip changed\n{text}\ninto\n{written}");
+        }
+    }
+    assert!(clean >= 50, "only {clean} mutated scenes were clean: the test exercises too little");
+}
