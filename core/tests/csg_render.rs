@@ -351,3 +351,42 @@ fn normal_transform_mode_applies_to_csg_surfaces() {
         .max();
     assert!(worst.unwrap_or(0) <= 1, "similitudes must not change normals ({worst:?})");
 }
+
+#[test]
+fn coincident_faces_give_one_consistent_surface() {
+    // A and B touch along the plane x = 0 and share their front face z = 1.
+    let a = "MaterialIndex 0 Box { min -1 -1 -1 max 0 1 1 }";
+    let b = "MaterialIndex 1 Box { min 0 -1 -1 max 1 1 1 }";
+    let (_, u) = tree(&csg("Union", a, b));
+    // No seam where the boxes meet: one interval through both.
+    assert_close(&ts(&u.intervals(&Ray::new(Vec3::new(-5.0, 0.3, 0.2), Vec3::X))), &[4.0, 6.0]);
+    // The same box twice: its front face is one boundary, A's.
+    let (c, _) = tree(&csg("Union", a, a));
+    let h = c.intersect(&Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z), 0.0, f32::INFINITY).expect("hit");
+    assert_eq!(c.hit_material(&h), 0);
+
+    // A box minus a slab sharing its front face: that face is gone at every pixel, and what
+    // shows is the slab's back face turned around, at z = 0.5, in the slab's material.
+    let cut = csg(
+        "Subtraction",
+        "MaterialIndex 0 Box { min -1 -1 -1 max 1 1 1 }",
+        "MaterialIndex 1 Box { min -1 -1 0.5 max 1 1 1 }",
+    );
+    let (c, _) = tree(&cut);
+    let front = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
+    let h = c.intersect(&front, 0.0, f32::INFINITY).expect("hit");
+    assert!((h.t - 4.5).abs() < 1e-6, "{}", h.t);
+    assert_eq!((c.hit_material(&h), c.world_normal(&front, &h, NormalTransform::Correct)), (1, Vec3::Z));
+    let mut seen = 0;
+    for row in 0..40 {
+        for x in 0..48 {
+            let ray = c.camera.pixel_ray(x, row, 48, 40);
+            if let Some(h) = c.intersect(&ray, c.camera.t_min(), f32::INFINITY) {
+                seen += 1;
+                let n = c.world_normal(&ray, &h, NormalTransform::Correct);
+                assert!(n.dot(ray.direction) < 0.0, "pixel {x},{row} shows a back face");
+            }
+        }
+    }
+    assert!(seen > 200);
+}
