@@ -16,6 +16,6 @@ pub use render::{
 };
 pub use scene::{
     DEFAULT_MATERIAL_COLOR,
-    Background, Camera, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
+    Background, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
     NodeKind, Scene, TransformOp,
 };

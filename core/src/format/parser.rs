@@ -3,6 +3,7 @@
 //! collected, not thrown: after an error the parser skips to the end of the enclosing block
 //! and carries on, so one pass reports as many problems as it can.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
@@ -11,8 +12,8 @@ use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
 use super::lexer::{TokKind, Token, tokenize};
 use super::obj::{MeshCache, resolve_obj_path};
 use crate::scene::{
-    Background, Camera, Graph, Light, Material, MaterialKeyword, MeshSlot, Node, NodeId, NodeKind,
-    Scene, TransformOp, compose,
+    Background, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node, NodeId,
+    NodeKind, Scene, TransformOp, check_closed, compose,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -92,6 +93,8 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         graph: None,
         material_refs: Vec::new(),
         leaf_offsets: Vec::new(),
+        node_offsets: Vec::new(),
+        closed_meshes: HashMap::new(),
     };
     p.parse_file();
     p.finish()
@@ -118,6 +121,11 @@ struct Parser<'a> {
     material_refs: Vec<(u32, usize)>,
     /// (node, offset) of each primitive, for warnings that need the final tree.
     leaf_offsets: Vec<(NodeId, usize)>,
+    /// Offset of each object's keyword, indexed by node id (for errors about operands).
+    node_offsets: Vec<usize>,
+    /// Closedness already checked, per mesh (by address), so a mesh used many times is
+    /// checked once.
+    closed_meshes: HashMap<usize, Result<(), String>>,
 }
 
 /// One `name value…` line inside a flat block.
@@ -146,9 +154,29 @@ enum Frame {
         ops: Vec<(TransformOp, usize)>,
         has_child: bool,
     },
+    /// Union, Intersection or Subtraction: operands, with MaterialIndex as in a Group.
+    Csg {
+        node: NodeId,
+        op: CsgOp,
+        keyword: usize,
+        open: usize,
+        count: usize,
+        material: Option<u32>,
+    },
 }
 
-const OBJECT_KEYWORDS: &[&str] = &["Group", "Transform", "Sphere", "Plane", "Triangle", "TriangleMesh"];
+const OBJECT_KEYWORDS: &[&str] = &[
+    "Group",
+    "Transform",
+    "Sphere",
+    "Plane",
+    "Triangle",
+    "TriangleMesh",
+    "Box",
+    "Union",
+    "Intersection",
+    "Subtraction",
+];
 
 fn is_numberlike(s: &str) -> bool {
     let first = s.as_bytes().first().copied().unwrap_or(b'a');
@@ -635,6 +663,7 @@ impl<'a> Parser<'a> {
                 let (kind, open) = match stack.last() {
                     Some(Frame::Group { open, .. }) => ("Group", *open),
                     Some(Frame::Transform { open, .. }) => ("Transform", *open),
+                    Some(Frame::Csg { op, open, .. }) => (op.name(), *open),
                     None => break,
                 };
                 self.error(open, format!("unterminated {kind} block: expected \"}}\" before the end of the file"));
@@ -725,6 +754,37 @@ impl<'a> Parser<'a> {
                                     }
                                 }
                             }
+                            Frame::Csg { node, op, count, material, .. } => {
+                                let (parent, op) = (*node, *op);
+                                if w == "MaterialIndex" {
+                                    if let Some((i, at)) = self.expect_count("MaterialIndex") {
+                                        let i = u32::try_from(i).unwrap_or(u32::MAX);
+                                        self.material_refs.push((i, at));
+                                        if let Some(Frame::Csg { material, .. }) = stack.last_mut() {
+                                            *material = Some(i);
+                                        }
+                                    }
+                                } else if OBJECT_KEYWORDS.contains(&w) {
+                                    *count += 1;
+                                    let mat = *material;
+                                    if let Some(f) = self.start_object(w, t.start, parent, mat, &mut graph) {
+                                        stack.push(f);
+                                    }
+                                } else {
+                                    if self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                                        *count += 1;
+                                    }
+                                    self.error(
+                                        t.start,
+                                        format!(
+                                            "unknown keyword \"{w}\" in {} (expected MaterialIndex or an operand: {})",
+                                            op.name(),
+                                            OBJECT_KEYWORDS[2..].join(", ")
+                                        ),
+                                    );
+                                    self.skip_following_block();
+                                }
+                            }
                         }
                     }
                 }
@@ -740,17 +800,41 @@ impl<'a> Parser<'a> {
         }
     }
 
+    /// An op's numbers, bare as the course writes them or in braces as the lecture's slides
+    /// do (`ZRotate { 45 }`); the writer always writes them bare.
+    fn op_numbers(&mut self, w: &str, n: usize) -> Option<Vec<f32>> {
+        if !self.peek().is_some_and(|t| t.kind == TokKind::Open) {
+            return self.expect_numbers(w, n);
+        }
+        self.pos += 1;
+        let v = self.expect_numbers(w, n);
+        match self.peek() {
+            Some(c) if c.kind == TokKind::Close && v.is_some() => {
+                self.pos += 1;
+                v
+            }
+            other => {
+                if v.is_some() {
+                    let (found, at) = self.describe(other);
+                    self.error(at, format!("expected \"}}\" to close {w} after {n} number(s), found {found}"));
+                }
+                self.skip_block();
+                None
+            }
+        }
+    }
+
     /// Parses a transform op after its keyword. Reports and returns None on failure
     /// (including an unknown keyword).
     fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
         let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
         Some(match w {
-            "Scale" => TransformOp::Scale(v3(self.expect_numbers(w, 3)?)),
-            "UniformScale" => TransformOp::UniformScale(self.expect_numbers(w, 1)?[0]),
-            "Translate" => TransformOp::Translate(v3(self.expect_numbers(w, 3)?)),
-            "XRotate" => TransformOp::XRotate(self.expect_numbers(w, 1)?[0]),
-            "YRotate" => TransformOp::YRotate(self.expect_numbers(w, 1)?[0]),
-            "ZRotate" => TransformOp::ZRotate(self.expect_numbers(w, 1)?[0]),
+            "Scale" => TransformOp::Scale(v3(self.op_numbers(w, 3)?)),
+            "UniformScale" => TransformOp::UniformScale(self.op_numbers(w, 1)?[0]),
+            "Translate" => TransformOp::Translate(v3(self.op_numbers(w, 3)?)),
+            "XRotate" => TransformOp::XRotate(self.op_numbers(w, 1)?[0]),
+            "YRotate" => TransformOp::YRotate(self.op_numbers(w, 1)?[0]),
+            "ZRotate" => TransformOp::ZRotate(self.op_numbers(w, 1)?[0]),
             "Rotate" | "Matrix" => {
                 self.expect_open(w)?;
                 let n = if w == "Rotate" { 4 } else { 16 };
@@ -801,25 +885,29 @@ impl<'a> Parser<'a> {
         graph: &mut Graph,
     ) -> Option<Frame> {
         let open = self.expect_open(w)?;
-        let attach = |graph: &mut Graph, kind: NodeKind| {
+        let mut attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind| {
             let id = graph.add(Node { kind, material, children: Vec::new() });
             graph.push_child(parent, id);
+            this.record_offset(id, off);
             id
         };
+        if let Some(op) = CsgOp::from_name(w) {
+            let node = attach(self, graph, NodeKind::Csg(op));
+            return Some(Frame::Csg { node, op, keyword: off, open, count: 0, material: None });
+        }
         match w {
             "Group" => {
-                let node = attach(graph, NodeKind::Group);
+                let node = attach(self, graph, NodeKind::Group);
                 Some(Frame::Group { node, open, declared: None, count: 0, material: None })
             }
             "Transform" => {
-                let node = attach(graph, NodeKind::Transform(Vec::new()));
+                let node = attach(self, graph, NodeKind::Transform(Vec::new()));
                 Some(Frame::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
             }
             _ => {
-                if let Some(kind) = self.parse_primitive(w, off, open) {
-                    let id = attach(graph, kind);
-                    self.leaf_offsets.push((id, off));
-                }
+                let kind = self.parse_primitive(w, off, open)?;
+                let id = attach(self, graph, kind);
+                self.leaf_offsets.push((id, off));
                 None
             }
         }
@@ -851,6 +939,17 @@ impl<'a> Parser<'a> {
                 let c = self.take_vec3(&mut f, w, off, "vertex2");
                 self.reject_unused(&f, w, "vertex0, vertex1, vertex2");
                 NodeKind::Triangle { vertices: [a?, b?, c?] }
+            }
+            "Box" => {
+                let min = self.take_vec3(&mut f, w, off, "min");
+                let max = self.take_vec3(&mut f, w, off, "max");
+                self.reject_unused(&f, w, "min, max");
+                let (min, max) = (min?, max?);
+                if min.cmpgt(max).any() {
+                    self.error(off, "Box: min must not exceed max on any axis");
+                    return None;
+                }
+                NodeKind::Box { min, max }
             }
             "TriangleMesh" => {
                 let Some(i) = f.iter().position(|x| x.name == "obj_file") else {
@@ -887,6 +986,18 @@ impl<'a> Parser<'a> {
 
     fn close_frame(&mut self, frame: Frame, graph: &mut Graph) {
         match frame {
+            Frame::Csg { node, op, keyword, count, .. } => {
+                if count != 2 {
+                    self.error(
+                        keyword,
+                        format!("{} needs exactly two operand objects (nest them for more), found {count}", op.name()),
+                    );
+                }
+                let operands = graph.node(node).children.clone();
+                for c in operands {
+                    self.check_operand(graph, c, op);
+                }
+            }
             Frame::Group { declared: Some((n, at)), count, .. } if n != count => {
                 self.error(at, format!("numObjects says {n} but the Group holds {count} object(s)"));
             }
@@ -908,6 +1019,52 @@ impl<'a> Parser<'a> {
                 }
                 graph.node_mut(node).kind = NodeKind::Transform(ops.into_iter().map(|o| o.0).collect());
             }
+        }
+    }
+
+    fn record_offset(&mut self, id: NodeId, off: usize) {
+        if self.node_offsets.len() <= id.index() {
+            self.node_offsets.resize(id.index() + 1, 0);
+        }
+        self.node_offsets[id.index()] = off;
+    }
+
+    /// An operand must bound a solid: follow Transforms down to the object they move.
+    fn check_operand(&mut self, graph: &Graph, id: NodeId, op: CsgOp) {
+        let mut cur = id;
+        while let Some(NodeKind::Transform(_)) = graph.get(cur).map(|n| &n.kind) {
+            match graph.node(cur).children.first() {
+                Some(&c) => cur = c,
+                // An empty Transform was reported when it closed.
+                None => return,
+            }
+        }
+        let at = self.node_offsets.get(cur.index()).copied().unwrap_or(0);
+        let Some(node) = graph.get(cur) else { return };
+        let name = op.name();
+        match &node.kind {
+            NodeKind::Sphere { .. } | NodeKind::Box { .. } | NodeKind::Plane { .. } | NodeKind::Csg(_) => {}
+            NodeKind::Triangle { .. } => self.error(
+                at,
+                format!("a lone Triangle is not a solid, so it cannot be an operand of {name} (use a closed TriangleMesh)"),
+            ),
+            NodeKind::Group => self.error(
+                at,
+                format!("a Group cannot be an operand of {name}: operands are solids (Sphere, Box, Plane, closed TriangleMesh, a Transform of one, or Union, Intersection, Subtraction); combine several with Union"),
+            ),
+            NodeKind::TriangleMesh { obj_file, mesh } => {
+                // A mesh that failed to load was reported already.
+                let Some(mesh) = mesh.mesh() else { return };
+                let key = std::sync::Arc::as_ptr(mesh) as usize;
+                let result = self.closed_meshes.entry(key).or_insert_with(|| check_closed(mesh)).clone();
+                if let Err(why) = result {
+                    self.node_error(
+                        at,
+                        format!("TriangleMesh \"{obj_file}\" is not a closed solid, so it cannot be an operand of {name}: {why}"),
+                    );
+                }
+            }
+            NodeKind::Transform(_) => {}
         }
     }
 

@@ -25,11 +25,11 @@ fn v3(v: Vec3) -> String {
     format!("{} {} {}", num(v.x), num(v.y), num(v.z))
 }
 
-/// True when the scene can be written in the course's own grammar (every scene tracelab can
-/// hold today); extensions added later must make this false when used.
+/// True when the scene can be written in the course's own grammar: it uses none of
+/// tracelab's extensions (Box, Union, Intersection, Subtraction), which are written only
+/// when used. (The slides' Material-in-Group shorthand is always written back canonically.)
 pub fn uses_only_course_grammar(scene: &Scene) -> bool {
-    let _ = scene;
-    true
+    !scene.graph.iter().any(|(_, n)| n.kind.is_extension())
 }
 
 pub fn write_scene(scene: &Scene) -> String {
@@ -119,7 +119,6 @@ enum Work {
 
 /// Depth-first with an explicit stack, so deep trees cannot overflow the call stack.
 fn write_graph(out: &mut String, graph: &Graph) {
-    let effective = graph.effective_materials();
     let mut stack = vec![Work::Open { id: graph.root(), depth: 0, in_group: false }];
     while let Some(w) = stack.pop() {
         let (id, depth, in_group) = match w {
@@ -146,10 +145,14 @@ fn write_graph(out: &mut String, graph: &Graph) {
         let inner = format!("{ind}{IND}");
         let _ = writeln!(out, "{ind}{} {{", node.kind.name());
         match &node.kind {
-            NodeKind::Group => {
-                let _ = writeln!(out, "{inner}numObjects {}", node.children.len());
-                // Emit MaterialIndex only where the material in effect changes.
-                let mut current = effective.get(id.index()).copied().flatten();
+            NodeKind::Group | NodeKind::Csg(_) => {
+                if node.kind == NodeKind::Group {
+                    let _ = writeln!(out, "{inner}numObjects {}", node.children.len());
+                }
+                // Emit MaterialIndex where a child's own material changes. A block starts
+                // with none set (what the reader does), so a child that sets the material it
+                // also inherits keeps its MaterialIndex.
+                let mut current = None;
                 let mut work = Vec::new();
                 for &c in &node.children {
                     let want = graph.get(c).and_then(|n| n.material);
@@ -194,6 +197,9 @@ fn write_graph(out: &mut String, graph: &Graph) {
             }
             NodeKind::TriangleMesh { obj_file, .. } => {
                 let _ = writeln!(out, "{inner}obj_file {obj_file}");
+            }
+            NodeKind::Box { min, max } => {
+                let _ = writeln!(out, "{inner}min {}\n{inner}max {}", v3(*min), v3(*max));
             }
         }
         let _ = writeln!(out, "{ind}}}");

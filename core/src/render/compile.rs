@@ -8,6 +8,7 @@ use std::sync::Arc;
 use glam::{Mat3, Mat4, Vec3};
 
 use super::camera::CameraRays;
+use super::csg::{CsgTree, box_face_normal, box_span};
 use super::NormalTransform;
 use crate::accel::Bvh;
 use crate::geometry::{Aabb, Ray, intersect_plane, intersect_sphere, intersect_triangle, triangle_normal};
@@ -20,6 +21,11 @@ pub enum Shape {
     Plane { normal: Vec3, offset: f32 },
     Triangle { vertices: [Vec3; 3], normal: Vec3 },
     Mesh(Arc<Mesh>),
+    /// An axis-aligned box in object space; a hit's `prim` is the face (axis·2, +1 for max).
+    Box { min: Vec3, max: Vec3 },
+    /// A CSG subtree whose leaves carry their own world transforms and materials; a hit's
+    /// `prim` is the boundary code of `csg::CsgTree` (leaf, exit and flip bits).
+    Csg(Arc<CsgTree>),
 }
 
 /// A transform with everything rays and normals need, computed once.
@@ -29,6 +35,14 @@ pub struct Xf {
     pub object_from_world: Mat4,
     /// (M⁻¹)ᵀ for normals: M itself skews them under non-uniform scale and shear.
     pub normal_from_object: Mat3,
+}
+
+impl Xf {
+    /// Inverts once, here, so no ray ever pays for it.
+    pub fn new(world_from_object: Mat4) -> Xf {
+        let inv = world_from_object.inverse();
+        Xf { world_from_object, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -46,7 +60,7 @@ pub struct Hit {
     /// World ray parameter.
     pub t: f32,
     pub object: u32,
-    /// Triangle index within a mesh (0 otherwise).
+    /// Triangle index within a mesh, face of a box, boundary code of a CSG hit (0 otherwise).
     pub prim: u32,
 }
 
@@ -103,11 +117,17 @@ impl CompiledScene {
                 }
                 NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. } => Shape::Mesh(mesh.clone()),
                 NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_), .. } => continue,
+                NodeKind::Box { min, max } => Shape::Box { min: *min, max: *max },
+                NodeKind::Csg(_) => {
+                    // One object for the whole subtree: its leaves keep their own transforms
+                    // and materials, and its bounds go into the top-level BVH.
+                    let resolve = |m: Option<u32>| m.filter(|&i| i < n_mat).unwrap_or(default_material);
+                    let tree = CsgTree::build(g, id, m, material, &resolve);
+                    objects.push(Object { shape: Shape::Csg(Arc::new(tree)), xf: None, material: resolve(material), node: id });
+                    continue;
+                }
             };
-            let xf = (m != Mat4::IDENTITY).then(|| {
-                let inv = m.inverse();
-                Xf { world_from_object: m, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
-            });
+            let xf = (m != Mat4::IDENTITY).then(|| Xf::new(m));
             let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
             objects.push(Object { shape, xf, material, node: id });
         }
@@ -185,6 +205,15 @@ impl CompiledScene {
                 intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0))
             }
             Shape::Mesh(m) => m.accel.intersect(r, t_min, t_max).map(|h| (h.t, h.triangle)),
+            Shape::Box { min, max } => {
+                let (t0, f0, t1, f1) = box_span(r, *min, *max)?;
+                if t0 > t_min && t0 < t_max {
+                    Some((t0, f0))
+                } else {
+                    (t1 > t_min && t1 < t_max).then_some((t1, f1))
+                }
+            }
+            Shape::Csg(tree) => tree.intersect(r, t_min, t_max),
         }
     }
 
@@ -202,11 +231,17 @@ impl CompiledScene {
             Shape::Plane { normal, .. } => *normal,
             Shape::Triangle { normal, .. } => *normal,
             Shape::Mesh(m) => m.face_normal(hit.prim),
+            Shape::Box { .. } => box_face_normal(hit.prim),
+            // CSG leaves have their own transforms: see `world_normal`.
+            Shape::Csg(_) => Vec3::Z,
         }
     }
 
     /// The world normal at a hit, normalised, by the chosen rule.
     pub fn world_normal(&self, ray: &Ray, hit: &Hit, mode: NormalTransform) -> Vec3 {
+        if let Some(Shape::Csg(tree)) = self.objects.get(hit.object as usize).map(|o| &o.shape) {
+            return tree.world_normal(ray, hit.t, hit.prim, mode);
+        }
         let n = self.object_normal(ray, hit);
         match self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()) {
             None => n,
@@ -219,6 +254,36 @@ impl CompiledScene {
 
     pub fn object_count(&self) -> usize {
         self.objects.len()
+    }
+
+    /// The material index a hit shades with: a CSG surface keeps its operand's material.
+    pub fn hit_material(&self, hit: &Hit) -> u32 {
+        match self.objects.get(hit.object as usize) {
+            Some(Object { shape: Shape::Csg(tree), .. }) => {
+                tree.leaf(hit.prim).map_or(self.default_material(), |l| l.material)
+            }
+            Some(o) => o.material,
+            None => self.default_material(),
+        }
+    }
+
+    /// The colour `hit_material` names.
+    pub fn hit_color(&self, hit: &Hit) -> Vec3 {
+        self.materials.get(self.hit_material(hit) as usize).copied().unwrap_or(DEFAULT_MATERIAL_COLOR)
+    }
+
+    /// The scene node a hit belongs to: for a CSG surface, the operand it came from, so the
+    /// pixel inspector and click-to-select find the Sphere or Box, not the Union.
+    pub fn hit_node(&self, hit: &Hit) -> Option<NodeId> {
+        match self.objects.get(hit.object as usize) {
+            Some(Object { shape: Shape::Csg(tree), node, .. }) => Some(tree.leaf(hit.prim).map_or(*node, |l| l.node)),
+            Some(o) => Some(o.node),
+            None => None,
+        }
+    }
+
+    fn default_material(&self) -> u32 {
+        self.materials.len().saturating_sub(1) as u32
     }
 
     pub fn material_color(&self, object: u32) -> Vec3 {
@@ -236,6 +301,9 @@ fn object_bounds(o: &Object) -> Aabb {
         Shape::Plane { .. } => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
         Shape::Triangle { vertices, .. } => Aabb::from_points(vertices),
         Shape::Mesh(m) => m.bounds(),
+        Shape::Box { min, max } => Aabb::new(*min, *max),
+        // Already in world space (the object has no transform of its own).
+        Shape::Csg(tree) => return tree.bounds(),
     };
     match &o.xf {
         Some(xf) if local.is_finite() => local.transformed(&xf.world_from_object),

@@ -82,7 +82,8 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, x: u32, row: u32) -> 
     match scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY) {
         Some(hit) => {
             let (c, n) = shade_fast(scene, &ray, &hit, s);
-            let node = scene.objects.get(hit.object as usize).map_or(u32::MAX, |o| o.node.0);
+            // The operand, for a CSG surface: what the pixel inspector and picking show.
+            let node = scene.hit_node(&hit).map_or(u32::MAX, |n| n.0);
             sample_from(c, n, hit.t, node)
         }
         None => {

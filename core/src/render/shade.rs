@@ -32,7 +32,7 @@ pub struct ShadeInfo {
 
 pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> ShadeInfo {
     let normal = scene.world_normal(ray, hit, settings.normal_transform);
-    let kd = scene.material_color(hit.object);
+    let kd = scene.hit_color(hit);
     let back_facing = ray.direction.dot(normal) > 0.0;
     let mut info = ShadeInfo {
         normal,
@@ -67,7 +67,7 @@ pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderS
 #[inline]
 pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> (Vec3, Vec3) {
     let normal = scene.world_normal(ray, hit, settings.normal_transform);
-    let kd = scene.material_color(hit.object);
+    let kd = scene.hit_color(hit);
     let mut n = normal;
     if ray.direction.dot(normal) > 0.0 {
         if !settings.shade_back {

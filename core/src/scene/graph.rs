@@ -25,6 +25,46 @@ pub enum NodeKind {
     Plane { normal: Vec3, offset: f32 },
     Triangle { vertices: [Vec3; 3] },
     TriangleMesh { obj_file: String, mesh: MeshSlot },
+    /// An axis-aligned box in object space (an extension: it rotates and shears under a
+    /// Transform).
+    Box { min: Vec3, max: Vec3 },
+    /// Constructive solid geometry over exactly two operand solids (an extension).
+    Csg(CsgOp),
+}
+
+/// How a CSG node combines its two operands A and B.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CsgOp {
+    Union,
+    Intersection,
+    /// A minus B.
+    Subtraction,
+}
+
+impl CsgOp {
+    pub const ALL: [CsgOp; 3] = [CsgOp::Union, CsgOp::Intersection, CsgOp::Subtraction];
+
+    /// The keyword in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            CsgOp::Union => "Union",
+            CsgOp::Intersection => "Intersection",
+            CsgOp::Subtraction => "Subtraction",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<CsgOp> {
+        CsgOp::ALL.into_iter().find(|op| op.name() == name)
+    }
+
+    /// Whether a point inside A (`a`) and/or B (`b`) is inside the result.
+    pub fn combine(self, a: bool, b: bool) -> bool {
+        match self {
+            CsgOp::Union => a || b,
+            CsgOp::Intersection => a && b,
+            CsgOp::Subtraction => a && !b,
+        }
+    }
 }
 
 impl NodeKind {
@@ -36,12 +76,20 @@ impl NodeKind {
             NodeKind::Plane { .. } => "Plane",
             NodeKind::Triangle { .. } => "Triangle",
             NodeKind::TriangleMesh { .. } => "TriangleMesh",
+            NodeKind::Box { .. } => "Box",
+            NodeKind::Csg(op) => op.name(),
         }
     }
 
-    /// Whether the node holds other objects (and how many it must hold).
+    /// Whether the node holds other objects (a Group any number, a Transform one, a CSG
+    /// node exactly two).
     pub fn is_container(&self) -> bool {
-        matches!(self, NodeKind::Group | NodeKind::Transform(_))
+        matches!(self, NodeKind::Group | NodeKind::Transform(_) | NodeKind::Csg(_))
+    }
+
+    /// Whether the node is one of tracelab's extensions to the course grammar.
+    pub fn is_extension(&self) -> bool {
+        matches!(self, NodeKind::Box { .. } | NodeKind::Csg(_))
     }
 }
 

@@ -78,3 +78,55 @@ impl MeshSlot {
         }
     }
 }
+
+/// Checks that a mesh bounds a solid: every edge is shared by exactly two triangles, so a
+/// ray's crossings alternate between entering and leaving. CSG needs that; an open mesh
+/// would give a wrong picture rather than an error.
+pub fn check_closed(mesh: &Mesh) -> Result<(), String> {
+    if mesh.triangles.is_empty() {
+        return Err("it has no triangles".to_string());
+    }
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(mesh.triangles.len() * 3);
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b)));
+        }
+    }
+    edges.sort_unstable();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i != 2 {
+            let (a, b) = edges[i];
+            return Err(format!(
+                "the edge between vertices {} and {} belongs to {} triangle(s), not 2",
+                a + 1,
+                b + 1,
+                j - i
+            ));
+        }
+        i = j;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tetra(faces: Vec<[u32; 3]>) -> Mesh {
+        Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z], faces)
+    }
+
+    #[test]
+    fn tetrahedron_is_closed_and_missing_face_is_not() {
+        let all = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+        assert_eq!(check_closed(&tetra(all.clone())), Ok(()));
+        let open = check_closed(&tetra(all[..3].to_vec())).expect_err("open");
+        assert!(open.contains("1 triangle(s)"), "{open}");
+    }
+}

@@ -6,8 +6,8 @@ mod graph;
 mod mesh;
 mod transform;
 
-pub use graph::{Graph, Node, NodeId, NodeKind};
-pub use mesh::{Mesh, MeshSlot};
+pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
+pub use mesh::{Mesh, MeshSlot, check_closed};
 pub use transform::{TransformOp, compose};
 
 use glam::Vec3;

@@ -1,0 +1,517 @@
+//! Constructive solid geometry by intervals along the ray, as the lecture describes it: each
+//! solid reports where the ray is inside it (sorted entry/exit boundaries over the whole
+//! line, so a ray that starts inside a solid is handled like any other), and each node
+//! combines its operands' intervals. The visible hit is the result's first boundary in range.
+//!
+//! A CSG subtree compiles to a post-order program over its leaves, evaluated with a stack,
+//! so deep nesting cannot overflow the call stack.
+
+use std::cell::RefCell;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+
+use super::NormalTransform;
+use super::compile::Xf;
+use crate::accel::TriangleHit;
+use crate::geometry::{Aabb, Ray};
+use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, compose};
+
+/// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low
+/// bits, whether the ray leaves that leaf there, and whether the normal is flipped (a
+/// surface of B exposed by a subtraction).
+pub const LEAF_MASK: u32 = (1 << 30) - 1;
+pub const EXIT_BIT: u32 = 1 << 30;
+pub const FLIP_BIT: u32 = 1 << 31;
+/// The code of an interval end at ±∞ (no surface there).
+const NO_SURFACE: u32 = LEAF_MASK;
+
+/// One end of an interval where the ray is inside a solid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound {
+    pub t: f32,
+    pub code: u32,
+}
+
+impl Bound {
+    pub fn leaf(&self) -> Option<u32> {
+        let l = self.code & LEAF_MASK;
+        (l != NO_SURFACE).then_some(l)
+    }
+    pub fn is_exit_of_leaf(&self) -> bool {
+        self.code & EXIT_BIT != 0
+    }
+    pub fn is_flipped(&self) -> bool {
+        self.code & FLIP_BIT != 0
+    }
+}
+
+/// A leaf's geometry in its object space.
+#[derive(Clone, Debug)]
+pub enum Solid {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
+    /// The half-space behind a Plane: {p : normal·p ≤ offset}, normal unit length.
+    HalfSpace {
+        normal: Vec3,
+        offset: f32,
+    },
+    /// A closed mesh (the parser rejects open ones).
+    Mesh(Arc<Mesh>),
+    /// Something that bounds no solid (a lone Triangle, an unloaded mesh, a missing
+    /// operand in an edited scene): it contributes nothing.
+    Empty,
+}
+
+#[derive(Clone, Debug)]
+pub struct CsgLeaf {
+    pub solid: Solid,
+    /// The leaf's whole world transform (Transforms above the CSG node included).
+    pub xf: Option<Xf>,
+    /// Index into `CompiledScene::materials`: a surface keeps its operand's material.
+    pub material: u32,
+    pub node: NodeId,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Step {
+    Leaf(u32),
+    Op(CsgOp),
+}
+
+/// A compiled CSG subtree.
+#[derive(Clone, Debug)]
+pub struct CsgTree {
+    pub leaves: Vec<CsgLeaf>,
+    /// Post-order: a leaf pushes its intervals, an op pops B then A and pushes the result.
+    program: Vec<Step>,
+    bounds: Aabb,
+}
+
+/// Reused buffers, so tracing a CSG pixel allocates nothing after the first.
+#[derive(Default)]
+struct Scratch {
+    heap: Vec<Bound>,
+    /// Start of each operand's bounds in `heap`.
+    starts: Vec<usize>,
+    combined: Vec<Bound>,
+    hits: Vec<TriangleHit>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl CsgTree {
+    /// Compiles the subtree under `root` (a Union, Intersection or Subtraction node).
+    /// `world_from_root` is the transform above it; `material` the material in effect there;
+    /// `resolve` maps a material in effect to an index into the compiled materials.
+    pub fn build(
+        graph: &Graph,
+        root: NodeId,
+        world_from_root: Mat4,
+        material: Option<u32>,
+        resolve: &dyn Fn(Option<u32>) -> u32,
+    ) -> CsgTree {
+        enum Work {
+            Visit(Option<NodeId>, Mat4, Option<u32>),
+            Emit(CsgOp),
+        }
+        let mut leaves = Vec::new();
+        let mut program = Vec::new();
+        let mut stack = vec![Work::Visit(Some(root), world_from_root, material)];
+        while let Some(w) = stack.pop() {
+            let (id, m, inherited) = match w {
+                Work::Emit(op) => {
+                    program.push(Step::Op(op));
+                    continue;
+                }
+                Work::Visit(id, m, inherited) => (id, m, inherited),
+            };
+            let node = id.and_then(|id| graph.get(id));
+            let material = node.and_then(|n| n.material).or(inherited);
+            let solid = match node.map(|n| &n.kind) {
+                Some(NodeKind::Csg(op)) => {
+                    let children = node.map_or(&[][..], |n| n.children.as_slice());
+                    // Exactly two operands; an edited scene may hold fewer, read as empty.
+                    stack.push(Work::Emit(*op));
+                    stack.push(Work::Visit(children.get(1).copied(), m, material));
+                    stack.push(Work::Visit(children.first().copied(), m, material));
+                    continue;
+                }
+                Some(NodeKind::Transform(ops)) => {
+                    let child = node.and_then(|n| n.children.first().copied());
+                    stack.push(Work::Visit(child, m * compose(ops), material));
+                    continue;
+                }
+                Some(NodeKind::Sphere { center, radius }) => Solid::Sphere { center: *center, radius: *radius },
+                Some(NodeKind::Box { min, max }) => Solid::Box { min: *min, max: *max },
+                Some(NodeKind::Plane { normal, offset }) => {
+                    Solid::HalfSpace { normal: normal.normalize_or(Vec3::Y), offset: *offset }
+                }
+                Some(NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. }) => Solid::Mesh(mesh.clone()),
+                // Groups, lone triangles and unloaded meshes bound no solid.
+                _ => Solid::Empty,
+            };
+            program.push(Step::Leaf(leaves.len() as u32));
+            leaves.push(CsgLeaf {
+                solid,
+                xf: (m != Mat4::IDENTITY).then(|| Xf::new(m)),
+                material: resolve(material),
+                node: id.unwrap_or(root),
+            });
+        }
+        let bounds = program_bounds(&program, &leaves);
+        CsgTree { leaves, program, bounds }
+    }
+
+    /// World-space bounds of the result (infinite when a half-space leaves it unbounded,
+    /// empty when nothing can be inside).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The result's boundaries along the whole ray (t from −∞ to ∞), sorted: entries and
+    /// exits alternate, starting with an entry. t is the world ray parameter.
+    pub fn intervals(&self, ray: &Ray) -> Vec<Bound> {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            self.evaluate(ray, &mut s);
+            s.heap.clone()
+        })
+    }
+
+    /// The first boundary with t in (t_min, t_max): (t, code).
+    pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            self.evaluate(ray, &mut s);
+            s.heap.iter().find(|b| b.t > t_min && b.t < t_max && b.leaf().is_some()).map(|b| (b.t, b.code))
+        })
+    }
+
+    fn evaluate(&self, ray: &Ray, s: &mut Scratch) {
+        let Scratch { heap, starts, combined, hits } = s;
+        heap.clear();
+        starts.clear();
+        for step in &self.program {
+            match *step {
+                Step::Leaf(i) => {
+                    starts.push(heap.len());
+                    if let Some(leaf) = self.leaves.get(i as usize) {
+                        let r = match &leaf.xf {
+                            // Not renormalised: t is the world ray parameter in every leaf.
+                            Some(xf) => ray.transformed(&xf.object_from_world),
+                            None => *ray,
+                        };
+                        leaf_bounds(&leaf.solid, &r, i, heap, hits);
+                    }
+                }
+                Step::Op(op) => {
+                    let (Some(sb), Some(sa)) = (starts.pop(), starts.pop()) else { continue };
+                    combined.clear();
+                    combine(op, &heap[sa..sb], &heap[sb..], combined);
+                    heap.truncate(sa);
+                    heap.extend_from_slice(combined);
+                    starts.push(sa);
+                }
+            }
+        }
+    }
+
+    /// The world normal of a hit with this code, normalised, by the chosen rule; flipped for
+    /// B's surfaces exposed by a subtraction.
+    pub fn world_normal(&self, ray: &Ray, t: f32, code: u32, mode: NormalTransform) -> Vec3 {
+        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
+        let r = match &leaf.xf {
+            Some(xf) => ray.transformed(&xf.object_from_world),
+            None => *ray,
+        };
+        let n = leaf_normal(&leaf.solid, &r, t, code & EXIT_BIT != 0);
+        let n = match (&leaf.xf, mode) {
+            (None, _) => n,
+            (Some(xf), NormalTransform::Correct) => (xf.normal_from_object * n).normalize_or(n),
+            (Some(xf), NormalTransform::Incorrect) => xf.world_from_object.transform_vector3(n).normalize_or(n),
+        };
+        if code & FLIP_BIT != 0 { -n } else { n }
+    }
+
+    pub fn leaf(&self, code: u32) -> Option<&CsgLeaf> {
+        self.leaves.get((code & LEAF_MASK) as usize)
+    }
+}
+
+fn program_bounds(program: &[Step], leaves: &[CsgLeaf]) -> Aabb {
+    let mut stack: Vec<Aabb> = Vec::new();
+    for step in program {
+        match *step {
+            Step::Leaf(i) => stack.push(leaves.get(i as usize).map_or(Aabb::EMPTY, leaf_world_bounds)),
+            Step::Op(op) => {
+                let (Some(b), Some(a)) = (stack.pop(), stack.pop()) else { continue };
+                stack.push(match op {
+                    CsgOp::Union => a.union(b),
+                    CsgOp::Intersection => {
+                        let i = Aabb::new(a.min.max(b.min), a.max.min(b.max));
+                        if i.is_empty() { Aabb::EMPTY } else { i }
+                    }
+                    CsgOp::Subtraction => a,
+                });
+            }
+        }
+    }
+    stack.pop().unwrap_or(Aabb::EMPTY)
+}
+
+fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
+    let local = match &leaf.solid {
+        Solid::Sphere { center, radius } => {
+            Aabb::new(*center - Vec3::splat(radius.abs()), *center + Vec3::splat(radius.abs()))
+        }
+        Solid::Box { min, max } => Aabb::new(*min, *max),
+        Solid::HalfSpace { .. } => return Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+        Solid::Mesh(m) => m.bounds(),
+        Solid::Empty => return Aabb::EMPTY,
+    };
+    match &leaf.xf {
+        Some(xf) => local.transformed(&xf.world_from_object),
+        None => local,
+    }
+}
+
+/// Both roots of |o + t d − c|² = r², the smaller first, computed exactly as
+/// `geometry::intersect_sphere` does, so a CSG sphere and a plain one meet a ray at the
+/// same t to the last bit.
+pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
+    let oc = ray.origin - center;
+    let a = ray.direction.length_squared();
+    let half_b = oc.dot(ray.direction);
+    let c = oc.length_squared() - radius * radius;
+    let disc = half_b * half_b - a * c;
+    if disc < 0.0 || a == 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    let q = -half_b - sq.copysign(half_b);
+    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+}
+
+/// A box face: axis · 2 + 1 for the max side. Its outward normal is `box_face_normal`.
+pub fn box_face_normal(face: u32) -> Vec3 {
+    let axis = (face / 2).min(2) as usize;
+    let mut n = Vec3::ZERO;
+    n[axis] = if face % 2 == 1 { 1.0 } else { -1.0 };
+    n
+}
+
+/// Where a ray is inside an axis-aligned box, by slabs, over the whole line:
+/// (t_enter, entry face, t_exit, exit face), or None if it misses (or only grazes an edge).
+pub fn box_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<(f32, u32, f32, u32)> {
+    let (o, d) = (ray.origin, ray.direction);
+    let (mut near, mut near_face) = (f32::NEG_INFINITY, 0u32);
+    let (mut far, mut far_face) = (f32::INFINITY, 0u32);
+    for axis in 0..3 {
+        if d[axis] == 0.0 {
+            // Parallel to this slab: inside it everywhere or nowhere.
+            if o[axis] < min[axis] || o[axis] > max[axis] {
+                return None;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[axis];
+        let (t_lo, t_hi) = ((min[axis] - o[axis]) * inv, (max[axis] - o[axis]) * inv);
+        let a = axis as u32 * 2;
+        // Moving toward +axis the ray enters through the min face and leaves through the max.
+        let (t_in, f_in, t_out, f_out) = if d[axis] > 0.0 { (t_lo, a, t_hi, a + 1) } else { (t_hi, a + 1, t_lo, a) };
+        if t_in > near {
+            near = t_in;
+            near_face = f_in;
+        }
+        if t_out < far {
+            far = t_out;
+            far_face = f_out;
+        }
+    }
+    (near < far).then_some((near, near_face, far, far_face))
+}
+
+/// Appends a leaf's sorted boundaries along the whole (object-space) ray.
+fn leaf_bounds(solid: &Solid, r: &Ray, leaf: u32, out: &mut Vec<Bound>, hits: &mut Vec<TriangleHit>) {
+    let mut span = |t0: f32, c0: u32, t1: f32, c1: u32| {
+        // `!(t0 < t1)` also rejects NaN, which must never reach `combine`.
+        if t0 < t1 {
+            out.push(Bound { t: t0, code: c0 });
+            out.push(Bound { t: t1, code: c1 });
+        }
+    };
+    let (enter, exit) = (leaf, leaf | EXIT_BIT);
+    match solid {
+        Solid::Sphere { center, radius } => {
+            if let Some((t0, t1)) = sphere_roots(r, *center, *radius) {
+                span(t0, enter, t1, exit);
+            }
+        }
+        Solid::Box { min, max } => {
+            if let Some((t0, _, t1, _)) = box_span(r, *min, *max) {
+                span(t0, enter, t1, exit);
+            }
+        }
+        Solid::HalfSpace { normal, offset } => {
+            let nd = normal.dot(r.direction);
+            let behind_origin = normal.dot(r.origin) <= *offset;
+            if nd == 0.0 {
+                if behind_origin {
+                    span(f32::NEG_INFINITY, NO_SURFACE, f32::INFINITY, NO_SURFACE);
+                }
+            } else {
+                let t = (offset - normal.dot(r.origin)) / nd;
+                if nd > 0.0 {
+                    span(f32::NEG_INFINITY, NO_SURFACE, t, exit);
+                } else {
+                    span(t, enter, f32::INFINITY, NO_SURFACE);
+                }
+            }
+        }
+        Solid::Mesh(mesh) => {
+            hits.clear();
+            mesh.accel.intersect_all(r, f32::NEG_INFINITY, f32::INFINITY, hits);
+            hits.sort_by(|a, b| a.t.total_cmp(&b.t));
+            // A ray through an edge or vertex meets several triangles at one t; keep one
+            // crossing per facing there, so crossings still alternate in and out.
+            let facing = |h: &TriangleHit| mesh.face_normal(h.triangle).dot(r.direction) > 0.0;
+            let mut kept: Vec<f32> = Vec::with_capacity(hits.len());
+            let mut last: Option<(f32, bool)> = None;
+            for h in hits.iter() {
+                let f = facing(h);
+                if let Some((t, lf)) = last
+                    && lf == f
+                    && (h.t - t).abs() <= 1e-6 * t.abs().max(1.0)
+                {
+                    continue;
+                }
+                last = Some((h.t, f));
+                kept.push(h.t);
+            }
+            // An odd count (a ray grazing a silhouette) loses its unmatched last crossing.
+            for pair in kept.chunks_exact(2) {
+                span(pair[0], enter, pair[1], exit);
+            }
+        }
+        Solid::Empty => {}
+    }
+}
+
+/// The object-space outward normal of a leaf at the boundary the ray crosses at t.
+fn leaf_normal(solid: &Solid, r: &Ray, t: f32, exit: bool) -> Vec3 {
+    match solid {
+        Solid::Sphere { center, .. } => (r.at(t) - *center).normalize_or(Vec3::Z),
+        Solid::Box { min, max } => match box_span(r, *min, *max) {
+            Some((_, f_in, _, f_out)) => box_face_normal(if exit { f_out } else { f_in }),
+            None => Vec3::Z,
+        },
+        Solid::HalfSpace { normal, .. } => *normal,
+        Solid::Mesh(mesh) => {
+            let mut hits = Vec::new();
+            mesh.accel.intersect_all(r, t.next_down(), t.next_up(), &mut hits);
+            let n = hits.first().map_or(Vec3::Z, |h| mesh.face_normal(h.triangle));
+            // Orient by the crossing, not the file's winding: out of the solid along the ray
+            // at an exit, against it at an entry.
+            if (n.dot(r.direction) > 0.0) != exit { -n } else { n }
+        }
+        Solid::Empty => Vec3::Z,
+    }
+}
+
+/// Combines two sorted boundary lists by `op` with one sweep. Boundaries at the same t are
+/// taken together, so coincident surfaces (A ∪ A, A − A) leave no seam and no sliver.
+pub fn combine(op: CsgOp, a: &[Bound], b: &[Bound], out: &mut Vec<Bound>) {
+    let (mut i, mut j) = (0, 0);
+    let (mut in_a, mut in_b, mut inside) = (false, false, false);
+    while i < a.len() || j < b.len() {
+        let ta = a.get(i).map_or(f32::INFINITY, |x| x.t);
+        let tb = b.get(j).map_or(f32::INFINITY, |x| x.t);
+        let t = ta.min(tb);
+        let was_a = in_a;
+        let (mut code_a, mut code_b) = (NO_SURFACE, NO_SURFACE);
+        let (i0, j0) = (i, j);
+        while let Some(x) = a.get(i).filter(|x| x.t <= t) {
+            in_a = !in_a;
+            code_a = x.code;
+            i += 1;
+        }
+        while let Some(x) = b.get(j).filter(|x| x.t <= t) {
+            in_b = !in_b;
+            code_b = x.code;
+            j += 1;
+        }
+        if i == i0 && j == j0 {
+            // Only a NaN could stop progress; leaves never produce one, but never loop.
+            break;
+        }
+        let now = op.combine(in_a, in_b);
+        if now != inside {
+            let code = if in_a != was_a {
+                code_a
+            } else if op == CsgOp::Subtraction {
+                // B's surface bounds A − B from the other side: its normal turns around.
+                code_b ^ FLIP_BIT
+            } else {
+                code_b
+            };
+            out.push(Bound { t, code });
+            inside = now;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn b(t: f32, code: u32) -> Bound {
+        Bound { t, code }
+    }
+
+    #[test]
+    fn combining_disjoint_and_overlapping_spans() {
+        let a = [b(0.0, 0), b(2.0, EXIT_BIT)];
+        let bb = [b(1.0, 1), b(3.0, 1 | EXIT_BIT)];
+        let mut out = Vec::new();
+        combine(CsgOp::Union, &a, &bb, &mut out);
+        assert_eq!(out, [b(0.0, 0), b(3.0, 1 | EXIT_BIT)]);
+        out.clear();
+        combine(CsgOp::Intersection, &a, &bb, &mut out);
+        assert_eq!(out, [b(1.0, 1), b(2.0, EXIT_BIT)]);
+        out.clear();
+        combine(CsgOp::Subtraction, &a, &bb, &mut out);
+        assert_eq!(out, [b(0.0, 0), b(1.0, 1 | FLIP_BIT)]);
+    }
+
+    #[test]
+    fn coincident_boundaries_leave_no_seam() {
+        let a = [b(0.0, 0), b(1.0, EXIT_BIT)];
+        let bb = [b(1.0, 1), b(2.0, 1 | EXIT_BIT)];
+        let mut out = Vec::new();
+        combine(CsgOp::Union, &a, &bb, &mut out);
+        assert_eq!(out, [b(0.0, 0), b(2.0, 1 | EXIT_BIT)]);
+        out.clear();
+        combine(CsgOp::Subtraction, &a, &a, &mut out);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn box_span_names_entry_and_exit_faces() {
+        let r = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+        let (t0, f0, t1, f1) = box_span(&r, Vec3::splat(-1.0), Vec3::splat(1.0)).expect("hit");
+        assert_eq!((t0, t1), (4.0, 6.0));
+        assert_eq!((box_face_normal(f0), box_face_normal(f1)), (Vec3::NEG_X, Vec3::X));
+        let miss = Ray::new(Vec3::new(-5.0, 2.0, 0.0), Vec3::X);
+        assert!(box_span(&miss, Vec3::splat(-1.0), Vec3::splat(1.0)).is_none());
+    }
+}
