@@ -36,6 +36,15 @@ fn parser_reports_missing_radius_with_location() {
 }
 
 #[test]
+fn a_short_vector_is_one_error_not_also_a_missing_next_field() {
+    let e = errors(&body("Group {\n    numObjects 1\n    MaterialIndex 0\n    Sphere { center 0 0 radius 1 }\n}\n"));
+    assert_eq!(e, [format!("{} expected 3 numbers after \"center\", found \"radius\"", at(4, 25))]);
+    // An unknown word in the same place is still reported once, as the found word.
+    let e = errors(&body("Group {\n    numObjects 1\n    MaterialIndex 0\n    Sphere { center 0 0 rad 1 radius 1 }\n}\n"));
+    assert_eq!(e, [format!("{} expected 3 numbers after \"center\", found \"rad\"", at(4, 25))]);
+}
+
+#[test]
 fn diagnostics_display_as_file_line_col() {
     let out = parse(&body("Group {\n    numObjects 1\n    MaterialIndex 0\n    Sphere { center 0 0 0 radius }\n}\n"));
     let d = out.diagnostics.errors().next().expect("an error");

@@ -137,6 +137,10 @@ struct Field {
     /// Text and offset of the token after the values, for "found …" in messages.
     after: (String, usize),
     used: bool,
+    /// Named as the "found …" of a field short of numbers: never reported as unknown, but
+    /// still taken if it is a real field (`center 0 0 radius 1` must not also say radius
+    /// is missing).
+    swallowed: bool,
 }
 
 enum Frame {
@@ -359,6 +363,7 @@ impl<'a> Parser<'a> {
                         word: None,
                         after: (String::new(), 0),
                         used: false,
+                        swallowed: false,
                     };
                     if name == "obj_file" {
                         match self.peek() {
@@ -394,11 +399,12 @@ impl<'a> Parser<'a> {
 
     /// Takes field `name` with exactly `n` numbers; reports what is wrong otherwise.
     fn take(&mut self, fields: &mut [Field], block: &str, block_off: usize, name: &str, n: usize) -> Option<Vec<f32>> {
-        let Some(i) = fields.iter().position(|f| f.name == name && !f.used) else {
+        let Some(i) = fields.iter().position(|f| f.name == name && (!f.used || f.swallowed)) else {
             self.error(block_off, format!("{block} is missing \"{name}\""));
             return None;
         };
         fields[i].used = true;
+        fields[i].swallowed = false;
         let f = &fields[i];
         if f.values.len() < n {
             let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
@@ -407,6 +413,7 @@ impl<'a> Parser<'a> {
             // it again as unknown.
             if let Some(next) = fields.get_mut(i + 1).filter(|g| g.name_off == off) {
                 next.used = true;
+                next.swallowed = true;
             }
             self.error(off, format!("expected {what} after \"{name}\", found {found}"));
             return None;
