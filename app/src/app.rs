@@ -466,9 +466,13 @@ impl TracelabApp {
         }
         if self.pixel_inspector_open {
             let mut open = true;
+            // Over the lower tree, leaving the render view free for the next click.
+            let at = ctx.content_rect().left_bottom() + egui::vec2(8.0, -30.0);
             egui::Window::new("Pixel inspector")
                 .open(&mut open)
                 .default_width(520.0)
+                .pivot(egui::Align2::LEFT_BOTTOM)
+                .default_pos(at)
                 .show(ctx, |ui| match &self.story {
                     Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
                     None => {
@@ -547,7 +551,7 @@ impl TracelabApp {
         let mut edits = Vec::new();
         egui::Panel::left("tree")
             .resizable(true)
-            .default_size(300.0)
+            .default_size(280.0)
             .show(ui, |ui| {
                 ui.heading("Scene");
                 let rows = std::mem::take(&mut self.rows.1);
@@ -556,17 +560,17 @@ impl TracelabApp {
             });
         egui::Panel::right("inspector")
             .resizable(true)
-            .default_size(320.0)
+            .default_size(300.0)
             .show(ui, |ui| {
                 ui.heading("Inspector");
                 edits.extend(inspector::ui(ui, &mut self.doc));
             });
         let mut pick = None;
+        let mut size = (1, 1);
         egui::CentralPanel::default().show(ui, |ui| {
             Viewport::toolbar(ui, &mut self.view);
             ui.separator();
-            let size =
-                Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
+            size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
             self.request_render(size);
             pick = self.viewport.images(ui, &mut self.view, &self.worker);
         });
@@ -577,6 +581,9 @@ impl TracelabApp {
             self.inspect(p.frame, p.x, p.row);
         }
         self.dialogs(&ctx);
+        // Edits and dialogs above changed the document after the view asked for its render:
+        // start the new one now, not on the next input event.
+        self.request_render(size);
         if !self.worker.is_idle() {
             ctx.request_repaint_after(Duration::from_millis(30));
         } else {

@@ -348,3 +348,27 @@ fn export_all_three_writes_every_view() {
         ["shot_color.png", "shot_normals.png", "shot_depth.png"]
     );
 }
+
+#[test]
+fn a_file_changed_on_disk_is_reloaded() {
+    let path = temp_dir("reload").join("sphere.txt");
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", "UniformScale 1")).expect("write");
+    let mut h = harness(Some(path.clone()), (16, 16));
+    settle(&mut h);
+    // Someone edits the file in a text editor beside the app.
+    std::thread::sleep(Duration::from_millis(20));
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", "UniformScale 0.5")).expect("write");
+    let start = Instant::now();
+    loop {
+        h.step();
+        let reloaded = h.state().doc.scene.graph.iter().any(|(_, n)| {
+            matches!(&n.kind, NodeKind::Transform(ops) if ops.first() == Some(&TransformOp::UniformScale(0.5)))
+        });
+        if reloaded {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(5), "not reloaded");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(!h.state().doc.is_dirty());
+}

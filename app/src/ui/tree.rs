@@ -117,7 +117,8 @@ pub fn ui(ui: &mut egui::Ui, doc: &mut Document, rows: &[TreeRow]) -> Vec<Edit> 
         ui.separator();
         let row_h = ui.spacing().interact_size.y;
         // Only visible rows are laid out: meshes and generated scenes can have many nodes.
-        egui::ScrollArea::vertical()
+        // Scrolls sideways too, so long summaries do not widen the panel.
+        egui::ScrollArea::both()
             .id_salt("objects")
             .auto_shrink([false, false])
             .show_rows(ui, row_h, rows.len(), |ui, range| {
