@@ -50,6 +50,8 @@ pub struct TracelabApp {
     pub disk_changed: bool,
     title: String,
     allow_close: bool,
+    /// The selection the tree last showed, to scroll to selections made elsewhere.
+    tree_seen: Option<Selection>,
     /// Timings in the status bar; snapshot tests turn them off to stay deterministic.
     pub show_timings: bool,
 }
@@ -73,6 +75,7 @@ impl TracelabApp {
             title: String::new(),
             allow_close: false,
             show_timings: true,
+            tree_seen: None,
         };
         if let Some(cc) = cc {
             let ctx = cc.egui_ctx.clone();
@@ -135,6 +138,7 @@ impl TracelabApp {
         let ok = self.doc.open(path).is_ok();
         if ok {
             self.story = None;
+            self.viewport.marker = None;
             self.disk_changed = false;
             self.recent.retain(|r| r != path);
             self.recent.insert(0, path.to_path_buf());
@@ -251,6 +255,7 @@ impl TracelabApp {
                     self.doc.selection = Some(Selection::Node(h.node));
                 }
             }
+            self.viewport.marker = Some((x, row));
             self.story = Some((story, scene));
             self.pixel_inspector_open = true;
         }
@@ -481,6 +486,9 @@ impl TracelabApp {
                 });
             self.pixel_inspector_open = open;
         }
+        if !self.pixel_inspector_open {
+            self.viewport.marker = None;
+        }
     }
 
     /// Watches the file: reload quietly when nothing is unsaved, else ask.
@@ -555,7 +563,12 @@ impl TracelabApp {
             .show(ui, |ui| {
                 ui.heading("Scene");
                 let rows = std::mem::take(&mut self.rows.1);
-                edits.extend(tree::ui(ui, &mut self.doc, &rows));
+                let reveal = match self.doc.selection {
+                    Some(Selection::Node(id)) if self.doc.selection != self.tree_seen => Some(id),
+                    _ => None,
+                };
+                edits.extend(tree::ui(ui, &mut self.doc, &rows, reveal));
+                self.tree_seen = self.doc.selection;
                 self.rows.1 = rows;
             });
         egui::Panel::right("inspector")

@@ -372,3 +372,28 @@ fn a_file_changed_on_disk_is_reloaded() {
     }
     assert!(!h.state().doc.is_dirty());
 }
+
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn a_scene_dropped_on_the_window_opens() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    let path = repo("scenes/hierarchy.txt");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(path.clone())));
+    h.step();
+    assert_eq!(h.state().doc.path.as_deref(), Some(path.as_path()));
+    assert_eq!(h.state().recent.first(), Some(&path));
+}

@@ -76,8 +76,14 @@ pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
     rows
 }
 
-/// Draws the tree; returns the edits asked for.
-pub fn ui(ui: &mut egui::Ui, doc: &mut Document, rows: &[TreeRow]) -> Vec<Edit> {
+/// Draws the tree; returns the edits asked for. `reveal` scrolls that node's row into view
+/// (when it was selected elsewhere, e.g. by clicking the render).
+pub fn ui(
+    ui: &mut egui::Ui,
+    doc: &mut Document,
+    rows: &[TreeRow],
+    reveal: Option<NodeId>,
+) -> Vec<Edit> {
     let mut edits = Vec::new();
     toolbar(ui, doc, &mut edits);
     ui.separator();
@@ -118,38 +124,42 @@ pub fn ui(ui: &mut egui::Ui, doc: &mut Document, rows: &[TreeRow]) -> Vec<Edit> 
         let row_h = ui.spacing().interact_size.y;
         // Only visible rows are laid out: meshes and generated scenes can have many nodes.
         // Scrolls sideways too, so long summaries do not widen the panel.
-        egui::ScrollArea::both()
+        let mut area = egui::ScrollArea::both()
             .id_salt("objects")
-            .auto_shrink([false, false])
-            .show_rows(ui, row_h, rows.len(), |ui, range| {
-                for row in &rows[range] {
-                    ui.horizontal(|ui| {
-                        ui.add_space(row.depth as f32 * 14.0);
-                        if let Some(m) = row.material {
-                            if let Some(mat) = doc.scene.materials.get(m as usize) {
-                                swatch(ui, mat.diffuse);
-                            }
+            .auto_shrink([false, false]);
+        if let Some(i) = reveal.and_then(|id| rows.iter().position(|r| r.id == id)) {
+            let step = row_h + ui.spacing().item_spacing.y;
+            area = area.vertical_scroll_offset(((i as f32 - 3.0) * step).max(0.0));
+        }
+        area.show_rows(ui, row_h, rows.len(), |ui, range| {
+            for row in &rows[range] {
+                ui.horizontal(|ui| {
+                    ui.add_space(row.depth as f32 * 14.0);
+                    if let Some(m) = row.material {
+                        if let Some(mat) = doc.scene.materials.get(m as usize) {
+                            swatch(ui, mat.diffuse);
                         }
-                        let mut text = row.label.clone();
-                        if let Some(m) = row.material {
-                            text.push_str(&format!("  [mat {m}]"));
-                        }
-                        let s = Selection::Node(row.id);
-                        let mut label = egui::RichText::new(text);
-                        if row.error.is_some() {
-                            label = label.color(ui.visuals().error_fg_color);
-                        }
-                        let r = ui.selectable_label(sel == Some(s), label);
-                        let r = match &row.error {
-                            Some(e) => r.on_hover_text(e),
-                            None => r,
-                        };
-                        if r.clicked() {
-                            clicked = Some(s);
-                        }
-                    });
-                }
-            });
+                    }
+                    let mut text = row.label.clone();
+                    if let Some(m) = row.material {
+                        text.push_str(&format!("  [mat {m}]"));
+                    }
+                    let s = Selection::Node(row.id);
+                    let mut label = egui::RichText::new(text);
+                    if row.error.is_some() {
+                        label = label.color(ui.visuals().error_fg_color);
+                    }
+                    let r = ui.selectable_label(sel == Some(s), label);
+                    let r = match &row.error {
+                        Some(e) => r.on_hover_text(e),
+                        None => r,
+                    };
+                    if r.clicked() {
+                        clicked = Some(s);
+                    }
+                });
+            }
+        });
     }
     if let Some(s) = clicked {
         doc.selection = Some(s);

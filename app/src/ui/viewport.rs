@@ -100,6 +100,10 @@ pub struct Viewport {
     uploaded: Vec<Option<(u64, u64, View, (u32, u32))>>,
     /// Size of the image shown, in pixels.
     pub shown_size: (u32, u32),
+    /// The pixel being inspected, marked in every image.
+    pub marker: Option<(u32, u32)>,
+    /// Generation of the image on screen, for the edit→screen timing log.
+    shown_generation: u64,
 }
 
 impl Viewport {
@@ -262,6 +266,19 @@ impl Viewport {
                     ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
                 }
                 let _ = ci;
+                if let Some((mx, my)) = self.marker {
+                    let c = rect.min
+                        + egui::vec2(
+                            (mx as f32 + 0.5) / w as f32 * rect.width(),
+                            (my as f32 + 0.5) / h as f32 * rect.height(),
+                        );
+                    let stroke = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 0, 255));
+                    ui.painter().circle_stroke(c, 6.0, stroke);
+                    ui.painter().hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
+                    ui.painter().hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
+                    ui.painter().vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
+                    ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
+                }
                 if resp.clicked() {
                     if let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p)) {
                         let u = (pos.x - rect.left()) / rect.width();
@@ -334,6 +351,16 @@ impl Viewport {
             }
             self.uploaded[i] = key;
             self.shown_size = (w, h);
+        }
+        if p.job.generation != self.shown_generation {
+            self.shown_generation = p.job.generation;
+            if std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0") {
+                eprintln!(
+                    "tracelab: generation {} on screen {:.1} ms after the edit",
+                    p.job.generation,
+                    p.job.submitted.elapsed().as_secs_f64() * 1e3
+                );
+            }
         }
     }
 
