@@ -120,16 +120,19 @@ impl Viewport {
             }
             ui.separator();
             ui.label("Normal transform:");
-            ui.selectable_value(
-                &mut s.normal_transform,
-                NormalTransform::Correct,
-                "Correct (M^-1)^T",
-            );
-            ui.selectable_value(
-                &mut s.normal_transform,
-                NormalTransform::Incorrect,
-                "Incorrect M",
-            );
+            // Compare mode shows both rules, so the switch has nothing to choose there.
+            ui.add_enabled_ui(s.compare == Compare::Off, |ui| {
+                ui.selectable_value(
+                    &mut s.normal_transform,
+                    NormalTransform::Correct,
+                    "Correct (M^-1)^T",
+                );
+                ui.selectable_value(
+                    &mut s.normal_transform,
+                    NormalTransform::Incorrect,
+                    "Incorrect M",
+                );
+            });
             ui.separator();
             egui::ComboBox::from_label("compare")
                 .selected_text(match s.compare {
@@ -228,11 +231,15 @@ impl Viewport {
                     continue;
                 };
                 let [w, h] = tex.size();
-                // Pixels shown 1:1 (or scaled down to fit), centred.
+                // View-sized renders show 1:1 (or scaled down to fit); a fixed size (say the
+                // handout's 200×200) is scaled up to fill the view, pixels kept sharp.
                 let size = egui::vec2(w as f32, h as f32) / ppp;
-                let scale = (img_area.width() / size.x)
-                    .min(img_area.height() / size.y)
-                    .min(1.0);
+                let fit = (img_area.width() / size.x).min(img_area.height() / size.y);
+                let scale = if s.fixed_size.is_some() {
+                    fit
+                } else {
+                    fit.min(1.0)
+                };
                 let rect = egui::Rect::from_center_size(img_area.center(), size * scale);
                 let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 if s.compare == Compare::Split {
