@@ -207,7 +207,9 @@ impl Viewport {
         });
         let avail = ui.available_size();
         let n = cells.len() as f32;
-        let cell_w = (avail.x / n).floor();
+        // Cells sit item_spacing apart; leave room for the gaps so the last one fits.
+        let gap = ui.spacing().item_spacing.x;
+        let cell_w = ((avail.x - gap * (n - 1.0)) / n).floor();
         let ppp = ui.pixels_per_point();
         ui.horizontal_top(|ui| {
             for (ci, &(frame, view, caption)) in cells.iter().enumerate() {
