@@ -397,3 +397,76 @@ fn a_scene_dropped_on_the_window_opens() {
     assert_eq!(h.state().doc.path.as_deref(), Some(path.as_path()));
     assert_eq!(h.state().recent.first(), Some(&path));
 }
+
+#[test]
+fn opening_over_unsaved_changes_asks_and_discard_opens() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(
+        tracelab_core::Material::diffuse(Vec3::ONE),
+    ));
+    let target = repo("scenes/hierarchy.txt");
+    h.state_mut().open(&target);
+    for _ in 0..3 {
+        h.step();
+    }
+    assert_eq!(h.state().confirm, Some(Pending::Open(target.clone())));
+    assert_eq!(h.state().doc.path, None, "nothing opened before the answer");
+    h.get_by_label("Discard changes").click();
+    h.step();
+    assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
+    assert!(!h.state().doc.is_dirty());
+}
+
+#[test]
+fn a_missing_obj_is_an_error_on_its_node_not_a_failure_to_open() {
+    let dir = temp_dir("missing-obj");
+    let path = dir.join("mesh.txt");
+    std::fs::write(
+        &path,
+        SPHERE_SCENE
+            .replace(
+                "Sphere { center 0 0 0 radius 1 }",
+                "TriangleMesh { obj_file nowhere.obj }",
+            )
+            .replace("OP", "UniformScale 1"),
+    )
+    .expect("write");
+    let mut h = harness(Some(path.clone()), (16, 16));
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(
+        app.doc.path.as_deref(),
+        Some(path.as_path()),
+        "the scene opened"
+    );
+    assert!(
+        app.doc.messages.iter().any(|m| m.contains("nowhere.obj")),
+        "{:?}",
+        app.doc.messages
+    );
+    let _ = h.get_by_label_contains("TriangleMesh: nowhere.obj (not loaded)");
+}
+
+#[test]
+fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    for _ in 0..3 {
+        h.step();
+    }
+    assert!(h.state().dialog.is_some());
+    let target = repo("scenes/flat_transforms.txt");
+    h.get_by_role(egui::accesskit::Role::TextInput).focus();
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text(&target.display().to_string());
+    h.step();
+    h.get_by_label("Open").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    assert!(h.state().dialog.is_none());
+    assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
+}
