@@ -296,10 +296,11 @@ impl TracelabApp {
         if pressed(cmd, Key::O) {
             self.dialog = Some(FileDialog::new(Purpose::Open, self.doc.path.as_deref()));
         }
-        if !ctx.egui_wants_keyboard_input() && ctx.input(|i| i.key_pressed(Key::Delete)) {
-            if let Some(Selection::Node(node)) = self.doc.selection {
-                self.apply(Edit::DeleteNode { node });
-            }
+        if !ctx.egui_wants_keyboard_input()
+            && ctx.input(|i| i.key_pressed(Key::Delete))
+            && let Some(Selection::Node(node)) = self.doc.selection
+        {
+            self.apply(Edit::DeleteNode { node });
         }
     }
 

@@ -87,11 +87,11 @@ impl FileDialog {
             .default_size([480.0, 400.0])
             .show(ctx, |ui| {
                 ui.horizontal(|ui| {
-                    if ui.button("Up a folder").clicked() {
-                        if let Some(p) = self.dir.parent() {
-                            self.dir = p.to_path_buf();
-                            self.refresh();
-                        }
+                    if ui.button("Up a folder").clicked()
+                        && let Some(p) = self.dir.parent()
+                    {
+                        self.dir = p.to_path_buf();
+                        self.refresh();
                     }
                     ui.label(self.dir.display().to_string());
                 });

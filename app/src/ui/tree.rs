@@ -135,10 +135,11 @@ pub fn ui(
             for row in &rows[range] {
                 ui.horizontal(|ui| {
                     ui.add_space(row.depth as f32 * 14.0);
-                    if let Some(m) = row.material {
-                        if let Some(mat) = doc.scene.materials.get(m as usize) {
-                            swatch(ui, mat.diffuse);
-                        }
+                    if let Some(mat) = row
+                        .material
+                        .and_then(|m| doc.scene.materials.get(m as usize))
+                    {
+                        swatch(ui, mat.diffuse);
                     }
                     let mut text = row.label.clone();
                     if let Some(m) = row.material {

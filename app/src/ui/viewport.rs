@@ -92,12 +92,15 @@ pub struct Pick {
     pub row: u32,
 }
 
+/// (generation, frame version, view, depth range bits): what a texture holds.
+type UploadKey = (u64, u64, View, (u32, u32));
+
 /// Texture state: what is on the GPU, so unchanged pixels are not uploaded again.
 #[derive(Default)]
 pub struct Viewport {
     textures: Vec<Option<egui::TextureHandle>>,
     /// Per texture: (generation, frame version, view, depth range) last uploaded.
-    uploaded: Vec<Option<(u64, u64, View, (u32, u32))>>,
+    uploaded: Vec<Option<UploadKey>>,
     /// Size of the image shown, in pixels.
     pub shown_size: (u32, u32),
     /// The pixel being inspected, marked in every image.
@@ -266,10 +269,10 @@ impl Viewport {
                         rect.y_range(),
                         egui::Stroke::new(2.0, egui::Color32::YELLOW),
                     );
-                    if resp.dragged() {
-                        if let Some(pos) = resp.interact_pointer_pos() {
-                            s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
-                        }
+                    if resp.dragged()
+                        && let Some(pos) = resp.interact_pointer_pos()
+                    {
+                        s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
                     }
                 } else {
                     ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
@@ -288,19 +291,19 @@ impl Viewport {
                     ui.painter().vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
                     ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
                 }
-                if resp.clicked() {
-                    if let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p)) {
-                        let u = (pos.x - rect.left()) / rect.width();
-                        let v = (pos.y - rect.top()) / rect.height();
-                        let frame = if s.compare == Compare::Split && u > s.split {
-                            1
-                        } else {
-                            frame
-                        };
-                        let x = ((u * w as f32) as u32).min(w as u32 - 1);
-                        let row = ((v * h as f32) as u32).min(h as u32 - 1);
-                        pick = Some(Pick { frame, x, row });
-                    }
+                if resp.clicked()
+                    && let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p))
+                {
+                    let u = (pos.x - rect.left()) / rect.width();
+                    let v = (pos.y - rect.top()) / rect.height();
+                    let frame = if s.compare == Compare::Split && u > s.split {
+                        1
+                    } else {
+                        frame
+                    };
+                    let x = ((u * w as f32) as u32).min(w as u32 - 1);
+                    let row = ((v * h as f32) as u32).min(h as u32 - 1);
+                    pick = Some(Pick { frame, x, row });
                 }
             }
         });
