@@ -470,3 +470,37 @@ fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
     assert!(h.state().dialog.is_none());
     assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
 }
+
+#[test]
+fn adding_a_triangle_mesh_and_loading_its_obj() {
+    let mut h = harness(Some(repo("scenes/flat_transforms.txt")), (16, 16));
+    settle(&mut h);
+    let before = h.state().doc.scene.graph.stats().triangles;
+    h.get_by_label("Add").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    h.get_by_label("TriangleMesh").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    let Some(Selection::Node(id)) = h.state().doc.selection else {
+        panic!("the new mesh is selected")
+    };
+    h.get_by_role(egui::accesskit::Role::TextInput).focus();
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text("../assets/torus.obj");
+    h.step();
+    h.get_by_label("Load / reload").click();
+    h.step();
+    let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc.scene.graph.node(id).kind else {
+        panic!("a TriangleMesh")
+    };
+    assert_eq!(obj_file, "../assets/torus.obj");
+    assert!(mesh.mesh().is_some(), "loaded: {mesh:?}");
+    assert!(h.state().doc.scene.graph.stats().triangles > before);
+    // Adding and loading are two undo steps; both undo cleanly.
+    assert!(h.state_mut().doc.undo() && h.state_mut().doc.undo());
+    assert_eq!(h.state().doc.scene.graph.stats().triangles, before);
+}

@@ -307,11 +307,17 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
             }
         }
         NodeKind::TriangleMesh { obj_file, mesh } => {
-            let mut path = obj_file.clone();
+            // The path being typed lives in egui's memory until it is loaded: an edit per
+            // keystroke would fill the undo history with half-typed names.
+            let buf_id = ui.id().with(("obj_file", id.0));
+            let mut path = ui
+                .data_mut(|d| d.get_temp::<String>(buf_id))
+                .unwrap_or_else(|| obj_file.clone());
             ui.horizontal(|ui| {
                 ui.label("obj_file");
                 ui.text_edit_singleline(&mut path);
             });
+            ui.data_mut(|d| d.insert_temp(buf_id, path.clone()));
             match mesh {
                 MeshSlot::Loaded(m) => {
                     ui.label(format!(
@@ -338,6 +344,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
                     }
                     Err(e) => MeshSlot::Failed(e),
                 };
+                ui.data_mut(|d| d.remove::<String>(buf_id));
                 edits.push(Edit::SetNodeKind {
                     node: id,
                     kind: NodeKind::TriangleMesh {
