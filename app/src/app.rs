@@ -509,6 +509,17 @@ impl TracelabApp {
 
     /// One frame of UI, shared by eframe and tests.
     pub fn frame(&mut self, ui: &mut egui::Ui) {
+        let t0 = Instant::now();
+        self.frame_inner(ui);
+        if std::env::var_os("TRACELAB_LOG_FRAMES").is_some() {
+            eprintln!(
+                "tracelab: ui code {:.1} ms",
+                t0.elapsed().as_secs_f64() * 1e3
+            );
+        }
+    }
+
+    fn frame_inner(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
         self.watch_disk();

@@ -368,9 +368,10 @@ impl Viewport {
             self.shown_generation = p.job.generation;
             if std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0") {
                 eprintln!(
-                    "tracelab: generation {} on screen {:.1} ms after the edit",
+                    "tracelab: generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
                     p.job.generation,
-                    p.job.submitted.elapsed().as_secs_f64() * 1e3
+                    p.job.submitted.elapsed().as_secs_f64() * 1e3,
+                    ctx.input(|i| i.unstable_dt) * 1e3
                 );
             }
         }
