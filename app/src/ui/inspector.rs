@@ -309,7 +309,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         NodeKind::TriangleMesh { obj_file, mesh } => {
             // The path being typed lives in egui's memory until it is loaded: an edit per
             // keystroke would fill the undo history with half-typed names.
-            let buf_id = ui.id().with(("obj_file", id.0));
+            let buf_id = ui.scope_id().with(("obj_file", id.0));
             let mut path = ui
                 .data_mut(|d| d.get_temp::<String>(buf_id))
                 .unwrap_or_else(|| obj_file.clone());
