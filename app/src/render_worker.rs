@@ -256,3 +256,74 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> Arc<Scene> {
+        let out = tracelab_core::parse_scene(
+            crate::DEFAULT_SCENE.as_bytes(),
+            "default",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        );
+        Arc::new(out.scene.expect("built-in scene parses"))
+    }
+
+    fn wait_idle(w: &RenderWorker) {
+        let start = Instant::now();
+        while !w.is_idle() {
+            assert!(
+                start.elapsed() < Duration::from_secs(30),
+                "worker never finished"
+            );
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    #[test]
+    fn a_newer_generation_replaces_the_render_in_flight() {
+        let mut w = RenderWorker::new();
+        let s = scene();
+        // A large first job, replaced at once: only the newest may be published at the end.
+        assert!(w.request(
+            1,
+            || s.clone(),
+            RenderSettings::new(1600, 1600),
+            vec![NormalTransform::Correct]
+        ));
+        assert!(w.request(
+            2,
+            || s.clone(),
+            RenderSettings::new(32, 24),
+            vec![NormalTransform::Correct]
+        ));
+        wait_idle(&w);
+        w.with_published(|p| {
+            let p = p.expect("published");
+            assert_eq!(p.job.generation, 2);
+            assert_eq!(p.passes_done, p.passes);
+            let f = p.frames[0].lock();
+            assert_eq!((f.width, f.height), (32, 24));
+        });
+    }
+
+    #[test]
+    fn the_same_request_twice_does_not_restart() {
+        let mut w = RenderWorker::new();
+        let s = scene();
+        let settings = RenderSettings::new(16, 16);
+        assert!(w.request(5, || s.clone(), settings, vec![NormalTransform::Correct]));
+        assert!(!w.request(5, || s.clone(), settings, vec![NormalTransform::Correct]));
+        // A new size or rule is a new render even at the same generation.
+        assert!(w.request(
+            5,
+            || s.clone(),
+            settings,
+            vec![NormalTransform::Correct, NormalTransform::Incorrect]
+        ));
+        wait_idle(&w);
+        w.with_published(|p| assert_eq!(p.expect("published").frames.len(), 2));
+    }
+}
