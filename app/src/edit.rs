@@ -296,8 +296,9 @@ fn transform_ops(
 }
 
 /// The node that stands for `node` inside a Group: itself, or the outermost of the
-/// Transforms wrapping it (a Transform holds exactly one object, so deleting or moving its
-/// object means deleting or moving the Transform).
+/// non-Group containers holding it. A Transform holds exactly one object (and a CSG node
+/// exactly two), so deleting or moving one of those objects means deleting or moving the
+/// container.
 fn group_slot(
     node: NodeId,
     root: NodeId,
@@ -311,7 +312,7 @@ fn group_slot(
     loop {
         let p = parent_of(slot).ok_or("not in the scene")?;
         match g.get(p).map(|n| &n.kind) {
-            Some(NodeKind::Transform(_)) if p != root => slot = p,
+            Some(k) if k.is_container() && !matches!(k, NodeKind::Group) && p != root => slot = p,
             _ => return Ok(slot),
         }
     }
