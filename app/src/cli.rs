@@ -172,11 +172,7 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
 }
 
 fn run_gui(scene: Option<PathBuf>) -> Result<(), CliError> {
-    // The editor lands with the GUI issue; until then, say so instead of doing nothing.
-    let _ = scene;
-    Err(CliError::Usage(
-        "the editor is not built yet; use 'tracelab render SCENE --output out.png' (see --help)".into(),
-    ))
+    crate::app::run(scene).map_err(CliError::Failed)
 }
 
 fn render_job(r: RenderArgs) -> Result<RenderJob, CliError> {

@@ -5,12 +5,14 @@ mod camera;
 mod compile;
 pub mod csg;
 mod frame;
+mod inspect;
 mod progressive;
 mod shade;
 
 pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, Shape, Xf};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
+pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use progressive::{Cancelled, PassInfo, SharedFrame, render_frame, render_full, render_progressive};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 

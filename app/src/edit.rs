@@ -1,0 +1,340 @@
+//! Edits as commands. Panels emit them; [`crate::state::Document::apply`] is the one place
+//! that carries them out (through [`apply_to`]) and records undo.
+
+use glam::Vec3;
+use tracelab_core::{
+    Background, Camera, Light, Material, Node, NodeId, NodeKind, Scene, TransformOp,
+};
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Edit {
+    SetTransformOp {
+        node: NodeId,
+        index: usize,
+        op: TransformOp,
+    },
+    AddOp {
+        node: NodeId,
+        op: TransformOp,
+    },
+    RemoveOp {
+        node: NodeId,
+        index: usize,
+    },
+    /// Moves op `from` to position `to` in the list.
+    MoveOp {
+        node: NodeId,
+        from: usize,
+        to: usize,
+    },
+    /// Replaces a primitive's parameters (a container keeps its children).
+    SetNodeKind {
+        node: NodeId,
+        kind: NodeKind,
+    },
+    /// The `MaterialIndex` in effect from this node on (`None`: inherit).
+    SetNodeMaterial {
+        node: NodeId,
+        material: Option<u32>,
+    },
+    /// Appends a new node to a Group (or to the Group holding the selected node).
+    AddNode {
+        parent: NodeId,
+        kind: NodeKind,
+    },
+    DeleteNode {
+        node: NodeId,
+    },
+    DuplicateNode {
+        node: NodeId,
+    },
+    /// Moves a node into another Group, at `index` among its children.
+    MoveNode {
+        node: NodeId,
+        new_parent: NodeId,
+        index: usize,
+    },
+    WrapInTransform {
+        node: NodeId,
+    },
+    WrapInGroup {
+        node: NodeId,
+    },
+    SetMaterial {
+        index: usize,
+        material: Material,
+    },
+    AddMaterial(Material),
+    /// Removes a material; nodes using it fall back to the material around them, and later
+    /// indices shift down so every other node keeps its colour.
+    RemoveMaterial {
+        index: usize,
+    },
+    SetCamera(Camera),
+    AddLight(Light),
+    RemoveLight {
+        index: usize,
+    },
+    SetLight {
+        index: usize,
+        light: Light,
+    },
+    SetBackground(Background),
+}
+
+/// Edits with the same key that follow each other (one drag) make a single undo step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CoalesceKey {
+    Op(NodeId, usize),
+    Kind(NodeId),
+    Material(usize),
+    Camera,
+    Light(usize),
+    Background,
+}
+
+impl Edit {
+    pub fn coalesce_key(&self) -> Option<CoalesceKey> {
+        match self {
+            Edit::SetTransformOp { node, index, .. } => Some(CoalesceKey::Op(*node, *index)),
+            Edit::SetNodeKind { node, .. } => Some(CoalesceKey::Kind(*node)),
+            Edit::SetMaterial { index, .. } => Some(CoalesceKey::Material(*index)),
+            Edit::SetCamera(_) => Some(CoalesceKey::Camera),
+            Edit::SetLight { index, .. } => Some(CoalesceKey::Light(*index)),
+            Edit::SetBackground(_) => Some(CoalesceKey::Background),
+            _ => None,
+        }
+    }
+}
+
+/// What an applied edit wants selected afterwards.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum After {
+    Keep,
+    SelectNode(NodeId),
+    ClearSelection,
+}
+
+/// Applies one edit to a scene. Never panics: an edit that does not fit the scene (a stale
+/// id, an index out of range, a move into its own subtree) is an error and changes nothing.
+pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
+    let g = &mut scene.graph;
+    let parents = g.parents();
+    let parent_of = |id: NodeId| parents.get(id.index()).copied().flatten();
+    let root = g.root();
+    let reachable = |id: NodeId| id == root || parent_of(id).is_some();
+    match edit {
+        Edit::SetTransformOp { node, index, op } => {
+            let slot = transform_ops(g, node)?.get_mut(index).ok_or("no such op")?;
+            *slot = op;
+        }
+        Edit::AddOp { node, op } => transform_ops(g, node)?.push(op),
+        Edit::RemoveOp { node, index } => {
+            let ops = transform_ops(g, node)?;
+            if index >= ops.len() {
+                return Err("no such op".into());
+            }
+            ops.remove(index);
+        }
+        Edit::MoveOp { node, from, to } => {
+            let ops = transform_ops(g, node)?;
+            if from >= ops.len() || to >= ops.len() {
+                return Err("no such op".into());
+            }
+            let op = ops.remove(from);
+            ops.insert(to, op);
+        }
+        Edit::SetNodeKind { node, kind } => {
+            let n = g.get_mut(node).ok_or("no such node")?;
+            if n.kind.is_container() || kind.is_container() {
+                return Err("only a primitive's parameters can be replaced".into());
+            }
+            n.kind = kind;
+        }
+        Edit::SetNodeMaterial { node, material } => {
+            if node == g.root() {
+                return Err("the root Group has no MaterialIndex".into());
+            }
+            g.get_mut(node).ok_or("no such node")?.material = material;
+        }
+        Edit::AddNode { parent, kind } => {
+            if !reachable(parent) || !matches!(g.node(parent).kind, NodeKind::Group) {
+                return Err("new objects go into a Group".into());
+            }
+            let id = if let NodeKind::Transform(_) = kind {
+                // A Transform always holds one object: give it a unit sphere to start with.
+                let child = g.add(Node::new(NodeKind::Sphere {
+                    center: Vec3::ZERO,
+                    radius: 1.0,
+                }));
+                let t = g.add(Node::new(kind));
+                g.push_child(t, child);
+                t
+            } else {
+                g.add(Node::new(kind))
+            };
+            g.push_child(parent, id);
+            return Ok(After::SelectNode(id));
+        }
+        Edit::DeleteNode { node } => {
+            let slot = group_slot(node, root, &parent_of, g)?;
+            let parent = parent_of(slot).ok_or("not in the scene")?;
+            g.node_mut(parent).children.retain(|&c| c != slot);
+            return Ok(After::ClearSelection);
+        }
+        Edit::DuplicateNode { node } => {
+            let slot = group_slot(node, root, &parent_of, g)?;
+            let parent = parent_of(slot).ok_or("not in the scene")?;
+            let copy = copy_subtree(g, slot);
+            let at = g
+                .node(parent)
+                .children
+                .iter()
+                .position(|&c| c == slot)
+                .map_or(0, |i| i + 1);
+            g.insert_child(parent, at, copy);
+            return Ok(After::SelectNode(copy));
+        }
+        Edit::MoveNode {
+            node,
+            new_parent,
+            index,
+        } => {
+            let slot = group_slot(node, root, &parent_of, g)?;
+            if !reachable(new_parent) || !matches!(g.node(new_parent).kind, NodeKind::Group) {
+                return Err("objects move into a Group".into());
+            }
+            if g.preorder_from(slot).contains(&new_parent) {
+                return Err("cannot move a node into itself".into());
+            }
+            let old_parent = parent_of(slot).ok_or("not in the scene")?;
+            let old_index = g
+                .node(old_parent)
+                .children
+                .iter()
+                .position(|&c| c == slot)
+                .unwrap_or(0);
+            g.node_mut(old_parent).children.retain(|&c| c != slot);
+            // Moving down within the same Group: the removal shifted the target left.
+            let index = if old_parent == new_parent && index > old_index {
+                index - 1
+            } else {
+                index
+            };
+            g.insert_child(new_parent, index, slot);
+            return Ok(After::SelectNode(node));
+        }
+        Edit::WrapInTransform { node } | Edit::WrapInGroup { node } => {
+            if node == g.root() {
+                return Err("the root Group cannot be wrapped".into());
+            }
+            let parent = parent_of(node).ok_or("not in the scene")?;
+            let kind = match edit {
+                Edit::WrapInTransform { .. } => NodeKind::Transform(Vec::new()),
+                _ => NodeKind::Group,
+            };
+            let mut wrapper = Node::new(kind);
+            // The MaterialIndex stays in front of whatever now sits in the parent.
+            wrapper.material = g.node_mut(node).material.take();
+            wrapper.children.push(node);
+            let w = g.add(wrapper);
+            for c in &mut g.node_mut(parent).children {
+                if *c == node {
+                    *c = w;
+                }
+            }
+            return Ok(After::SelectNode(w));
+        }
+        Edit::SetMaterial { index, material } => {
+            *scene.materials.get_mut(index).ok_or("no such material")? = material;
+        }
+        Edit::AddMaterial(m) => scene.materials.push(m),
+        Edit::RemoveMaterial { index } => {
+            if index >= scene.materials.len() {
+                return Err("no such material".into());
+            }
+            scene.materials.remove(index);
+            let index = index as u32;
+            for id in g.preorder() {
+                let n = g.node_mut(id);
+                n.material = match n.material {
+                    Some(m) if m == index => None,
+                    Some(m) if m > index => Some(m - 1),
+                    other => other,
+                };
+            }
+        }
+        Edit::SetCamera(c) => scene.camera = c,
+        Edit::AddLight(l) => scene.lights.get_or_insert_with(Vec::new).push(l),
+        Edit::RemoveLight { index } => {
+            let lights = scene.lights.as_mut().ok_or("no lights")?;
+            if index >= lights.len() {
+                return Err("no such light".into());
+            }
+            lights.remove(index);
+        }
+        Edit::SetLight { index, light } => {
+            *scene
+                .lights
+                .as_mut()
+                .and_then(|l| l.get_mut(index))
+                .ok_or("no such light")? = light;
+        }
+        Edit::SetBackground(b) => scene.background = b,
+    }
+    Ok(After::Keep)
+}
+
+fn transform_ops(
+    g: &mut tracelab_core::Graph,
+    node: NodeId,
+) -> Result<&mut Vec<TransformOp>, String> {
+    match g.get_mut(node).map(|n| &mut n.kind) {
+        Some(NodeKind::Transform(ops)) => Ok(ops),
+        _ => Err("not a Transform".into()),
+    }
+}
+
+/// The node that stands for `node` inside a Group: itself, or the outermost of the
+/// non-Group containers holding it. A Transform holds exactly one object (and a CSG node
+/// exactly two), so deleting or moving one of those objects means deleting or moving the
+/// container.
+fn group_slot(
+    node: NodeId,
+    root: NodeId,
+    parent_of: &dyn Fn(NodeId) -> Option<NodeId>,
+    g: &tracelab_core::Graph,
+) -> Result<NodeId, String> {
+    if node == root {
+        return Err("the root Group cannot be moved or deleted".into());
+    }
+    let mut slot = node;
+    loop {
+        let p = parent_of(slot).ok_or("not in the scene")?;
+        match g.get(p).map(|n| &n.kind) {
+            Some(k) if k.is_container() && !matches!(k, NodeKind::Group) && p != root => slot = p,
+            _ => return Ok(slot),
+        }
+    }
+}
+
+/// Copies a subtree into new arena slots; returns the copy's root.
+fn copy_subtree(g: &mut tracelab_core::Graph, src: NodeId) -> NodeId {
+    let order = g.preorder_from(src);
+    let mut map = std::collections::HashMap::new();
+    for &id in &order {
+        let n = g.node(id).clone();
+        map.insert(
+            id,
+            g.add(Node {
+                children: Vec::new(),
+                ..n
+            }),
+        );
+    }
+    for &id in &order {
+        let kids: Vec<NodeId> = g.node(id).children.iter().map(|c| map[c]).collect();
+        g.node_mut(map[&id]).children = kids;
+    }
+    map[&src]
+}

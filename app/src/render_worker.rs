@@ -1,0 +1,329 @@
+//! Background rendering. The UI submits an immutable snapshot of the scene with its
+//! generation; the worker compiles it, cancels the render in flight, and renders the new one
+//! progressively into fresh frames. The UI thread never renders and never waits: it reads the
+//! latest published result, and results of older generations are simply replaced.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use tracelab_core::render::render_progressive;
+use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
+
+/// What to render: one frame per normal rule in `modes` (two in compare mode).
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub generation: u64,
+    pub scene: Arc<Scene>,
+    pub settings: RenderSettings,
+    pub modes: Vec<NormalTransform>,
+    /// When the edit that caused this job happened (for edit→image timings).
+    pub submitted: Instant,
+}
+
+/// The render the UI should show.
+pub struct Published {
+    pub job: Job,
+    pub compiled: Arc<CompiledScene>,
+    /// One per `job.modes`, filled progressively.
+    pub frames: Vec<Arc<SharedFrame>>,
+    /// Passes completed by every frame (the least of them).
+    pub passes_done: usize,
+    pub passes: usize,
+    pub first_image: Option<Duration>,
+    pub full: Option<Duration>,
+}
+
+#[derive(Default)]
+struct Shared {
+    published: Mutex<Option<Published>>,
+    repaint: Mutex<Option<Box<dyn Fn() + Send>>>,
+}
+
+pub struct RenderWorker {
+    tx: Option<Sender<(Job, Arc<AtomicBool>)>>,
+    cancel: Arc<AtomicBool>,
+    shared: Arc<Shared>,
+    thread: Option<std::thread::JoinHandle<()>>,
+    last_generation: u64,
+    last_key: Option<(u32, u32, bool, Vec<NormalTransform>)>,
+}
+
+impl Default for RenderWorker {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RenderWorker {
+    pub fn new() -> Self {
+        let (tx, rx) = channel::<(Job, Arc<AtomicBool>)>();
+        let shared = Arc::new(Shared::default());
+        let s = shared.clone();
+        let thread = std::thread::Builder::new()
+            .name("tracelab-render".into())
+            .spawn(move || worker_loop(&rx, &s))
+            .ok();
+        RenderWorker {
+            tx: Some(tx),
+            cancel: Arc::new(AtomicBool::new(false)),
+            shared,
+            thread,
+            last_generation: 0,
+            last_key: None,
+        }
+    }
+
+    /// Called (from the worker thread) whenever there are new pixels to show.
+    pub fn set_repaint(&self, f: impl Fn() + Send + 'static) {
+        *self
+            .shared
+            .repaint
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Some(Box::new(f));
+    }
+
+    /// Starts a render unless the same generation at the same settings is already going.
+    /// Returns whether a new render started.
+    pub fn request(
+        &mut self,
+        generation: u64,
+        scene: impl FnOnce() -> Arc<Scene>,
+        settings: RenderSettings,
+        modes: Vec<NormalTransform>,
+    ) -> bool {
+        let key = (
+            settings.width,
+            settings.height,
+            settings.shade_back,
+            modes.clone(),
+        );
+        if generation == self.last_generation && self.last_key.as_ref() == Some(&key) {
+            return false;
+        }
+        self.last_generation = generation;
+        self.last_key = Some(key);
+        // Stop the render in flight within a tile; the next job gets a fresh flag.
+        self.cancel.store(true, Ordering::Relaxed);
+        self.cancel = Arc::new(AtomicBool::new(false));
+        let job = Job {
+            generation,
+            scene: scene(),
+            settings,
+            modes,
+            submitted: Instant::now(),
+        };
+        if let Some(tx) = &self.tx {
+            let _ = tx.send((job, self.cancel.clone()));
+        }
+        true
+    }
+
+    /// Reads the latest published render.
+    pub fn with_published<R>(&self, f: impl FnOnce(Option<&Published>) -> R) -> R {
+        let p = self
+            .shared
+            .published
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        f(p.as_ref())
+    }
+
+    /// Whether the newest request has been fully rendered.
+    pub fn is_idle(&self) -> bool {
+        self.with_published(|p| {
+            p.is_some_and(|p| p.job.generation == self.last_generation && p.full.is_some())
+        })
+    }
+
+    pub fn last_generation(&self) -> u64 {
+        self.last_generation
+    }
+}
+
+impl Drop for RenderWorker {
+    fn drop(&mut self) {
+        self.cancel.store(true, Ordering::Relaxed);
+        self.tx = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
+    let log = std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0");
+    while let Ok(mut next) = rx.recv() {
+        // Only the newest request matters.
+        while let Ok(newer) = rx.try_recv() {
+            next = newer;
+        }
+        let (job, cancel) = next;
+        if cancel.load(Ordering::Relaxed) {
+            continue;
+        }
+        let compiled = Arc::new(CompiledScene::new(&job.scene));
+        let frames: Vec<Arc<SharedFrame>> = job
+            .modes
+            .iter()
+            .map(|_| Arc::new(SharedFrame::new()))
+            .collect();
+        let passes_done: Vec<std::sync::atomic::AtomicUsize> = job
+            .modes
+            .iter()
+            .map(|_| std::sync::atomic::AtomicUsize::new(0))
+            .collect();
+        {
+            // The UI keeps showing its previous image until this one has its first pass.
+            let mut p = shared
+                .published
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner);
+            let new = Published {
+                job: job.clone(),
+                compiled: compiled.clone(),
+                frames: frames.clone(),
+                passes_done: 0,
+                passes: 0,
+                first_image: None,
+                full: None,
+            };
+            *p = Some(new);
+        }
+        let on_pass = |i: usize, passes: usize| {
+            passes_done[i].fetch_add(1, Ordering::Relaxed);
+            let least = passes_done
+                .iter()
+                .map(|a| a.load(Ordering::Relaxed))
+                .min()
+                .unwrap_or(0);
+            let mut p = shared
+                .published
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner);
+            if let Some(p) = p.as_mut().filter(|p| p.job.generation == job.generation) {
+                p.passes = passes;
+                if least > p.passes_done {
+                    p.passes_done = least;
+                    let t = job.submitted.elapsed();
+                    if least == 1 {
+                        p.first_image = Some(t);
+                    }
+                    if least == p.passes {
+                        p.full = Some(t);
+                    }
+                }
+            }
+            drop(p);
+            if let Some(f) = shared
+                .repaint
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .as_ref()
+            {
+                f();
+            }
+        };
+        let render_one = |i: usize| {
+            let settings = RenderSettings {
+                normal_transform: job.modes[i],
+                ..job.settings
+            };
+            render_progressive(&compiled, &settings, &frames[i], &cancel, |info| {
+                on_pass(i, info.passes)
+            })
+            .is_ok()
+        };
+        let ok = if frames.len() == 2 {
+            let (a, b) = rayon::join(|| render_one(0), || render_one(1));
+            a && b
+        } else {
+            (0..frames.len()).all(render_one)
+        };
+        if ok && log {
+            shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_ref().inspect(|p| {
+                eprintln!(
+                    "tracelab: generation {} {}x{}{}: edit to first image {:.1} ms, to full refinement {:.1} ms",
+                    p.job.generation,
+                    p.job.settings.width,
+                    p.job.settings.height,
+                    if p.frames.len() > 1 { " (compare)" } else { "" },
+                    p.first_image.unwrap_or_default().as_secs_f64() * 1e3,
+                    p.full.unwrap_or_default().as_secs_f64() * 1e3,
+                );
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> Arc<Scene> {
+        let out = tracelab_core::parse_scene(
+            crate::DEFAULT_SCENE.as_bytes(),
+            "default",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        );
+        Arc::new(out.scene.expect("built-in scene parses"))
+    }
+
+    fn wait_idle(w: &RenderWorker) {
+        let start = Instant::now();
+        while !w.is_idle() {
+            assert!(
+                start.elapsed() < Duration::from_secs(30),
+                "worker never finished"
+            );
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    #[test]
+    fn a_newer_generation_replaces_the_render_in_flight() {
+        let mut w = RenderWorker::new();
+        let s = scene();
+        // A large first job, replaced at once: only the newest may be published at the end.
+        assert!(w.request(
+            1,
+            || s.clone(),
+            RenderSettings::new(1600, 1600),
+            vec![NormalTransform::Correct]
+        ));
+        assert!(w.request(
+            2,
+            || s.clone(),
+            RenderSettings::new(32, 24),
+            vec![NormalTransform::Correct]
+        ));
+        wait_idle(&w);
+        w.with_published(|p| {
+            let p = p.expect("published");
+            assert_eq!(p.job.generation, 2);
+            assert_eq!(p.passes_done, p.passes);
+            let f = p.frames[0].lock();
+            assert_eq!((f.width, f.height), (32, 24));
+        });
+    }
+
+    #[test]
+    fn the_same_request_twice_does_not_restart() {
+        let mut w = RenderWorker::new();
+        let s = scene();
+        let settings = RenderSettings::new(16, 16);
+        assert!(w.request(5, || s.clone(), settings, vec![NormalTransform::Correct]));
+        assert!(!w.request(5, || s.clone(), settings, vec![NormalTransform::Correct]));
+        // A new size or rule is a new render even at the same generation.
+        assert!(w.request(
+            5,
+            || s.clone(),
+            settings,
+            vec![NormalTransform::Correct, NormalTransform::Incorrect]
+        ));
+        wait_idle(&w);
+        w.with_published(|p| assert_eq!(p.expect("published").frames.len(), 2));
+    }
+}

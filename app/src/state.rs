@@ -1,0 +1,257 @@
+//! The document as plain data: the scene, where it came from, what is selected, and the
+//! undo history. No GUI types here, so all of it is testable without a window.
+
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+use tracelab_core::{MeshCache, NodeId, Scene};
+
+use crate::edit::{After, CoalesceKey, Edit, apply_to};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Selection {
+    Camera,
+    Lights,
+    Light(usize),
+    Background,
+    Materials,
+    Material(usize),
+    Node(NodeId),
+}
+
+/// One state in the history: the scene and the id of that state (for the dirty flag).
+struct Snapshot {
+    scene: Scene,
+    state_id: u64,
+}
+
+pub struct Document {
+    pub scene: Scene,
+    /// `None` for the built-in scene or a scene never saved.
+    pub path: Option<PathBuf>,
+    pub selection: Option<Selection>,
+    /// Bumped on every change to `scene`; the render worker drops work for older ones.
+    pub generation: u64,
+    /// Errors and warnings from the last open, save or edit (file:line:col for scene files).
+    pub messages: Vec<String>,
+    /// Modification time of `path` when last read or written, to notice outside changes.
+    pub disk_stamp: Option<SystemTime>,
+    pub mesh_cache: MeshCache,
+    undo: Vec<Snapshot>,
+    redo: Vec<Snapshot>,
+    state_id: u64,
+    next_state_id: u64,
+    saved_state_id: u64,
+    /// The key of the last edit while a drag goes on, so the drag is one undo step.
+    gesture: Option<CoalesceKey>,
+}
+
+/// Keeps memory bounded on large scenes; 200 steps is far more than anyone undoes.
+const MAX_UNDO: usize = 200;
+
+impl Document {
+    pub fn new(scene: Scene, path: Option<PathBuf>) -> Self {
+        let disk_stamp = path.as_deref().and_then(modified);
+        Document {
+            scene,
+            path,
+            selection: None,
+            generation: 1,
+            messages: Vec::new(),
+            disk_stamp,
+            mesh_cache: MeshCache::new(),
+            undo: Vec::new(),
+            redo: Vec::new(),
+            state_id: 0,
+            next_state_id: 1,
+            saved_state_id: 0,
+            gesture: None,
+        }
+    }
+
+    /// The built-in scene.
+    pub fn builtin() -> Self {
+        let mut cache = MeshCache::new();
+        let out = tracelab_core::parse_scene(
+            crate::DEFAULT_SCENE.as_bytes(),
+            crate::DEFAULT_SCENE_NAME,
+            None,
+            &mut cache,
+        );
+        let scene = out.scene.unwrap_or_default();
+        let mut d = Document::new(scene, None);
+        d.mesh_cache = cache;
+        d
+    }
+
+    pub fn title_name(&self) -> String {
+        match &self.path {
+            Some(p) => p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().to_string(),
+            ),
+            None => crate::DEFAULT_SCENE_NAME.to_string(),
+        }
+    }
+
+    pub fn is_dirty(&self) -> bool {
+        self.state_id != self.saved_state_id
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// Applies an edit, recording undo; edits of one drag coalesce into one step.
+    pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
+        let key = edit.coalesce_key();
+        let merge = key.is_some() && key == self.gesture;
+        let before = (!merge).then(|| self.scene.clone());
+        match apply_to(&mut self.scene, edit) {
+            Ok(after) => {
+                if let Some(scene) = before {
+                    self.push_undo(scene);
+                    self.state_id = self.next_state_id;
+                    self.next_state_id += 1;
+                }
+                self.redo.clear();
+                self.gesture = key;
+                self.generation += 1;
+                match after {
+                    After::Keep => {}
+                    After::SelectNode(id) => self.selection = Some(Selection::Node(id)),
+                    After::ClearSelection => self.selection = None,
+                }
+                self.fix_selection();
+                Ok(())
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Ends the current drag: the next edit starts a new undo step.
+    pub fn end_gesture(&mut self) {
+        self.gesture = None;
+    }
+
+    fn push_undo(&mut self, scene: Scene) {
+        self.undo.push(Snapshot {
+            scene,
+            state_id: self.state_id,
+        });
+        if self.undo.len() > MAX_UNDO {
+            self.undo.remove(0);
+        }
+    }
+
+    pub fn undo(&mut self) -> bool {
+        let Some(prev) = self.undo.pop() else {
+            return false;
+        };
+        let cur = std::mem::replace(&mut self.scene, prev.scene);
+        self.redo.push(Snapshot {
+            scene: cur,
+            state_id: self.state_id,
+        });
+        self.state_id = prev.state_id;
+        self.after_history_move();
+        true
+    }
+
+    pub fn redo(&mut self) -> bool {
+        let Some(next) = self.redo.pop() else {
+            return false;
+        };
+        let cur = std::mem::replace(&mut self.scene, next.scene);
+        self.undo.push(Snapshot {
+            scene: cur,
+            state_id: self.state_id,
+        });
+        self.state_id = next.state_id;
+        self.after_history_move();
+        true
+    }
+
+    fn after_history_move(&mut self) {
+        self.gesture = None;
+        self.generation += 1;
+        self.fix_selection();
+    }
+
+    /// Drops a selection that no longer points at anything.
+    fn fix_selection(&mut self) {
+        let ok = match self.selection {
+            None
+            | Some(
+                Selection::Camera
+                | Selection::Lights
+                | Selection::Background
+                | Selection::Materials,
+            ) => true,
+            Some(Selection::Light(i)) => i < self.scene.lights().len(),
+            Some(Selection::Material(i)) => i < self.scene.materials.len(),
+            Some(Selection::Node(id)) => self.scene.graph.path_to(id).is_some(),
+        };
+        if !ok {
+            self.selection = None;
+        }
+    }
+
+    /// Opens a file. A file that cannot be read at all leaves the current scene open and
+    /// reports why; per-node errors (a missing OBJ) open the scene and report them.
+    pub fn open(&mut self, path: &Path) -> Result<(), String> {
+        let out = tracelab_core::load_scene(path, &mut self.mesh_cache);
+        let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
+        match out.scene {
+            Some(scene) => {
+                let cache = std::mem::take(&mut self.mesh_cache);
+                let generation = self.generation + 1;
+                *self = Document::new(scene, Some(path.to_path_buf()));
+                self.mesh_cache = cache;
+                self.messages = messages;
+                // Generations stay monotonic across documents: the worker compares them.
+                self.generation = generation;
+                Ok(())
+            }
+            None => {
+                let text = messages.join("\n");
+                self.messages = messages;
+                Err(text)
+            }
+        }
+    }
+
+    /// Writes the scene atomically (temporary file + rename) and marks it saved.
+    pub fn save_as(&mut self, path: &Path) -> Result<(), String> {
+        let text = tracelab_core::write_scene(&self.scene);
+        crate::cli::write_atomic(path, text.as_bytes())
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        self.path = Some(path.to_path_buf());
+        self.saved_state_id = self.state_id;
+        self.disk_stamp = modified(path);
+        Ok(())
+    }
+
+    pub fn save(&mut self) -> Result<(), String> {
+        match self.path.clone() {
+            Some(p) => self.save_as(&p),
+            None => Err("the built-in scene has no file yet: use Save As".into()),
+        }
+    }
+
+    /// True when the file on disk changed since it was read or written.
+    pub fn changed_on_disk(&self) -> bool {
+        match (&self.path, self.disk_stamp) {
+            (Some(p), Some(stamp)) => modified(p).is_some_and(|m| m != stamp),
+            _ => false,
+        }
+    }
+}
+
+fn modified(p: &Path) -> Option<SystemTime> {
+    std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}

@@ -1,0 +1,468 @@
+//! The inspector (right panel): every parameter of the selection, as widgets that emit
+//! [`Edit`]s. Widgets edit copies; nothing here changes the document directly.
+
+use egui::DragValue;
+use glam::{Mat4, Vec3};
+use tracelab_core::{Background, Camera, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
+
+use crate::edit::Edit;
+use crate::state::{Document, Selection};
+
+pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
+    let mut edits = Vec::new();
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| match doc.selection {
+            None => {
+                ui.label(
+                    "Select something in the scene tree, or click an object in the render view.",
+                );
+            }
+            Some(Selection::Camera) => camera(ui, &doc.scene.camera, &mut edits),
+            Some(Selection::Lights) => {
+                ui.heading("Lights");
+                if doc.scene.lights.is_none() {
+                    ui.label("No Lights block: the scene is shown flat in its diffuse colours.");
+                }
+                for i in 0..doc.scene.lights().len() {
+                    ui.separator();
+                    light(ui, doc, i, &mut edits);
+                }
+                if ui.button("Add light").clicked() {
+                    edits.push(Edit::AddLight(Light {
+                        direction: Vec3::new(-0.5, -1.0, -0.5),
+                        color: Vec3::splat(0.5),
+                    }));
+                }
+            }
+            Some(Selection::Light(i)) => light(ui, doc, i, &mut edits),
+            Some(Selection::Background) => background(ui, &doc.scene.background, &mut edits),
+            Some(Selection::Materials) => {
+                ui.heading("Materials");
+                for i in 0..doc.scene.materials.len() {
+                    material(ui, doc, i, &mut edits);
+                }
+                if ui.button("Add material").clicked() {
+                    edits.push(Edit::AddMaterial(Material::diffuse(Vec3::splat(0.7))));
+                }
+            }
+            Some(Selection::Material(i)) => {
+                ui.heading(format!("Material {i}"));
+                material(ui, doc, i, &mut edits);
+            }
+            Some(Selection::Node(id)) => node(ui, doc, id, &mut edits),
+        });
+    edits
+}
+
+/// Three drag values labelled for screen readers and tests (e.g. "Translate x").
+pub fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        ui.label(name);
+        for (axis, c) in [("x", &mut v.x), ("y", &mut v.y), ("z", &mut v.z)] {
+            let r = ui.add(DragValue::new(&mut *c).speed(speed).max_decimals(4));
+            name_widget(&r, format!("{name} {axis}"), f64::from(*c));
+            changed |= r.changed();
+        }
+    });
+    changed
+}
+
+/// Gives a drag value an accessible name (screen readers, and tests that find it by label).
+fn name_widget(r: &egui::Response, name: String, value: f64) {
+    r.widget_info(|| egui::WidgetInfo {
+        label: Some(name.clone()),
+        ..egui::WidgetInfo::drag_value(true, value)
+    });
+}
+
+fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
+    ui.horizontal(|ui| {
+        ui.label(name);
+        let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
+        name_widget(&r, name.to_string(), f64::from(*v));
+        r.changed()
+    })
+    .inner
+}
+
+fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
+    ui.horizontal(|ui| {
+        ui.label(name);
+        let mut rgb = c.to_array();
+        let changed = ui.color_edit_button_rgb(&mut rgb).changed();
+        let mut changed2 = false;
+        for v in &mut rgb {
+            changed2 |= ui
+                .add(
+                    DragValue::new(v)
+                        .speed(0.005)
+                        .range(0.0..=4.0)
+                        .max_decimals(3),
+                )
+                .changed();
+        }
+        *c = Vec3::from_array(rgb);
+        changed || changed2
+    })
+    .inner
+}
+
+fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
+    ui.heading("Camera");
+    let mut c = cam.clone();
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let ortho = matches!(c, Camera::Orthographic { .. });
+        if ui.selectable_label(ortho, "Orthographic").clicked() && !ortho {
+            c = Camera::Orthographic {
+                center: c.center(),
+                direction: c.direction(),
+                up: c.up(),
+                size: 5.0,
+            };
+            changed = true;
+        }
+        if ui.selectable_label(!ortho, "Perspective").clicked() && ortho {
+            c = Camera::Perspective {
+                center: c.center(),
+                direction: c.direction(),
+                up: c.up(),
+                angle: 30.0,
+            };
+            changed = true;
+        }
+    });
+    match &mut c {
+        Camera::Orthographic {
+            center,
+            direction,
+            up,
+            size,
+        } => {
+            changed |= vec3(ui, "center", center, 0.02);
+            changed |= vec3(ui, "direction", direction, 0.01);
+            changed |= vec3(ui, "up", up, 0.01);
+            changed |= scalar(ui, "size", size, 0.02);
+        }
+        Camera::Perspective {
+            center,
+            direction,
+            up,
+            angle,
+        } => {
+            changed |= vec3(ui, "center", center, 0.02);
+            changed |= vec3(ui, "direction", direction, 0.01);
+            changed |= vec3(ui, "up", up, 0.01);
+            changed |= scalar(ui, "angle (degrees)", angle, 0.1);
+            *angle = angle.clamp(0.1, 179.0);
+        }
+    }
+    if changed {
+        edits.push(Edit::SetCamera(c));
+    }
+}
+
+fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
+    let Some(l) = doc.scene.lights().get(i) else {
+        return;
+    };
+    let mut l = l.clone();
+    ui.strong(format!("Light {i} (directional)"));
+    let mut changed = vec3(ui, "direction", &mut l.direction, 0.01);
+    changed |= color(ui, "colour", &mut l.color);
+    if changed {
+        edits.push(Edit::SetLight { index: i, light: l });
+    }
+    if ui.button(format!("Remove light {i}")).clicked() {
+        edits.push(Edit::RemoveLight { index: i });
+    }
+}
+
+fn background(ui: &mut egui::Ui, bg: &Background, edits: &mut Vec<Edit>) {
+    ui.heading("Background");
+    let mut b = bg.clone();
+    let mut changed = false;
+    for (name, field) in [("colour", &mut b.color), ("ambient light", &mut b.ambient)] {
+        let mut on = field.is_some();
+        ui.horizontal(|ui| {
+            if ui.checkbox(&mut on, "").changed() {
+                *field = on.then_some(Vec3::ZERO);
+                changed = true;
+            }
+            if let Some(c) = field {
+                changed |= color(ui, name, c);
+            } else {
+                ui.label(format!("{name} (not set: black)"));
+            }
+        });
+    }
+    if changed {
+        edits.push(Edit::SetBackground(b));
+    }
+}
+
+fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
+    let Some(m) = doc.scene.materials.get(i) else {
+        return;
+    };
+    let mut m = m.clone();
+    ui.horizontal(|ui| {
+        let mut c = m.diffuse;
+        if color(ui, &format!("{i}: diffuse"), &mut c) {
+            m.diffuse = c;
+            edits.push(Edit::SetMaterial {
+                index: i,
+                material: m.clone(),
+            });
+        }
+        if ui
+            .button("Remove")
+            .on_hover_text(format!("Remove material {i}"))
+            .clicked()
+        {
+            edits.push(Edit::RemoveMaterial { index: i });
+        }
+    });
+}
+
+fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>) {
+    let g = &doc.scene.graph;
+    let Some(n) = g.get(id) else { return };
+    ui.heading(n.kind.name());
+    if let Some(path) = g.path_to(id) {
+        let names: Vec<&str> = path
+            .iter()
+            .filter_map(|&p| g.get(p))
+            .map(|n| n.kind.name())
+            .collect();
+        ui.small(names.join(" › "));
+    }
+    // MaterialIndex
+    if id != g.root() {
+        let mats = doc.scene.materials.len() as u32;
+        let current = n.material;
+        let eff = g.effective_materials().get(id.index()).copied().flatten();
+        let text = |m: Option<u32>| m.map_or("inherit".to_string(), |m| format!("Material {m}"));
+        let mut chosen = current;
+        egui::ComboBox::from_label("material")
+            .selected_text(match current {
+                Some(_) => text(current),
+                None => format!(
+                    "inherit ({})",
+                    eff.map_or("default".into(), |m| format!("Material {m}"))
+                ),
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut chosen, None, "inherit");
+                for m in 0..mats {
+                    ui.selectable_value(&mut chosen, Some(m), text(Some(m)));
+                }
+            });
+        if chosen != current {
+            edits.push(Edit::SetNodeMaterial {
+                node: id,
+                material: chosen,
+            });
+        }
+    }
+    ui.separator();
+    let mut kind = n.kind.clone();
+    match &mut kind {
+        NodeKind::Transform(ops) => transform_ops(ui, id, ops, edits),
+        NodeKind::Group => {
+            ui.label(format!("{} objects", n.children.len()));
+        }
+        NodeKind::Sphere { center, radius } => {
+            let mut c = vec3(ui, "center", center, 0.02);
+            c |= scalar(ui, "radius", radius, 0.01);
+            if c {
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: kind.clone(),
+                });
+            }
+        }
+        NodeKind::Plane { normal, offset } => {
+            let mut c = vec3(ui, "normal", normal, 0.01);
+            c |= scalar(ui, "offset", offset, 0.02);
+            if c {
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: kind.clone(),
+                });
+            }
+        }
+        NodeKind::Triangle { vertices } => {
+            let mut c = false;
+            for (i, v) in vertices.iter_mut().enumerate() {
+                c |= vec3(ui, &format!("vertex{i}"), v, 0.02);
+            }
+            if c {
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: kind.clone(),
+                });
+            }
+        }
+        NodeKind::TriangleMesh { obj_file, mesh } => {
+            // The path being typed lives in egui's memory until it is loaded: an edit per
+            // keystroke would fill the undo history with half-typed names.
+            let buf_id = ui.scope_id().with(("obj_file", id.0));
+            let mut path = ui
+                .data_mut(|d| d.get_temp::<String>(buf_id))
+                .unwrap_or_else(|| obj_file.clone());
+            ui.horizontal(|ui| {
+                ui.label("obj_file");
+                ui.text_edit_singleline(&mut path);
+            });
+            ui.data_mut(|d| d.insert_temp(buf_id, path.clone()));
+            match mesh {
+                MeshSlot::Loaded(m) => {
+                    ui.label(format!(
+                        "{} vertices, {} triangles",
+                        m.positions.len(),
+                        m.triangle_count()
+                    ));
+                }
+                MeshSlot::Failed(e) => {
+                    ui.colored_label(ui.visuals().error_fg_color, e.as_str());
+                }
+            }
+            if ui.button("Load / reload").clicked()
+                || (path != *obj_file && ui.input(|i| i.key_pressed(egui::Key::Enter)))
+            {
+                let base = doc.path.as_deref().and_then(|p| p.parent());
+                let slot = match tracelab_core::format::obj::resolve_obj_path(&path, base) {
+                    Ok(p) => {
+                        doc.mesh_cache.forget(&p);
+                        match doc.mesh_cache.load(&p) {
+                            Ok(m) => MeshSlot::Loaded(m),
+                            Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
+                        }
+                    }
+                    Err(e) => MeshSlot::Failed(e),
+                };
+                ui.data_mut(|d| d.remove::<String>(buf_id));
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: NodeKind::TriangleMesh {
+                        obj_file: path,
+                        mesh: slot,
+                    },
+                });
+            }
+        }
+        #[allow(unreachable_patterns)]
+        _ => {
+            ui.label("This node has no editable parameters here yet.");
+        }
+    }
+}
+
+fn op_names() -> [(&'static str, TransformOp); 8] {
+    [
+        ("Translate", TransformOp::Translate(Vec3::ZERO)),
+        ("Scale", TransformOp::Scale(Vec3::ONE)),
+        ("UniformScale", TransformOp::UniformScale(1.0)),
+        ("XRotate", TransformOp::XRotate(0.0)),
+        ("YRotate", TransformOp::YRotate(0.0)),
+        ("ZRotate", TransformOp::ZRotate(0.0)),
+        (
+            "Rotate",
+            TransformOp::Rotate {
+                axis: Vec3::Y,
+                degrees: 0.0,
+            },
+        ),
+        ("Matrix", TransformOp::Matrix(Mat4::IDENTITY)),
+    ]
+}
+
+fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], edits: &mut Vec<Edit>) {
+    ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
+    let n = ops.len();
+    for (index, op) in ops.iter_mut().enumerate() {
+        ui.push_id(index, |ui| {
+            ui.group(|ui| {
+                let changed = match op {
+                    TransformOp::Translate(v) => vec3(ui, "Translate", v, 0.02),
+                    TransformOp::Scale(v) => vec3(ui, "Scale", v, 0.01),
+                    TransformOp::UniformScale(s) => scalar(ui, "UniformScale", s, 0.01),
+                    TransformOp::XRotate(d) => scalar(ui, "XRotate (degrees)", d, 0.5),
+                    TransformOp::YRotate(d) => scalar(ui, "YRotate (degrees)", d, 0.5),
+                    TransformOp::ZRotate(d) => scalar(ui, "ZRotate (degrees)", d, 0.5),
+                    TransformOp::Rotate { axis, degrees } => {
+                        let a = vec3(ui, "Rotate axis", axis, 0.01);
+                        scalar(ui, "Rotate degrees", degrees, 0.5) || a
+                    }
+                    TransformOp::Matrix(m) => matrix(ui, m),
+                };
+                if changed {
+                    edits.push(Edit::SetTransformOp {
+                        node,
+                        index,
+                        op: op.clone(),
+                    });
+                }
+                ui.horizontal(|ui| {
+                    if ui.add_enabled(index > 0, egui::Button::new("Up")).clicked() {
+                        edits.push(Edit::MoveOp {
+                            node,
+                            from: index,
+                            to: index - 1,
+                        });
+                    }
+                    if ui
+                        .add_enabled(index + 1 < n, egui::Button::new("Down"))
+                        .clicked()
+                    {
+                        edits.push(Edit::MoveOp {
+                            node,
+                            from: index,
+                            to: index + 1,
+                        });
+                    }
+                    if ui.button("Remove").clicked() {
+                        edits.push(Edit::RemoveOp { node, index });
+                    }
+                });
+            });
+        });
+    }
+    ui.menu_button("Add op", |ui| {
+        for (name, op) in op_names() {
+            if ui.button(name).clicked() {
+                edits.push(Edit::AddOp { node, op });
+                ui.close();
+            }
+        }
+    });
+}
+
+/// A 4×4 matrix edited row by row, as the file writes it.
+fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
+    let mut changed = false;
+    ui.label("Matrix (rows)");
+    let mut rows = [
+        m.row(0).to_array(),
+        m.row(1).to_array(),
+        m.row(2).to_array(),
+        m.row(3).to_array(),
+    ];
+    egui::Grid::new("matrix").show(ui, |ui| {
+        for row in &mut rows {
+            for c in row.iter_mut() {
+                changed |= ui
+                    .add(DragValue::new(c).speed(0.01).max_decimals(4))
+                    .changed();
+            }
+            ui.end_row();
+        }
+    });
+    if changed {
+        *m = Mat4::from_cols_array_2d(&rows).transpose();
+    }
+    changed
+}

@@ -1,0 +1,104 @@
+//! The pixel inspector: the story of one pixel's ray, from the core's `inspect_pixel`.
+
+use glam::Vec3;
+use tracelab_core::render::RayStory;
+use tracelab_core::{NodeKind, NormalTransform, Scene};
+
+fn v(v: Vec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+/// Draws the story. `scene` is the snapshot the story was traced in.
+pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
+    let RayStory {
+        x,
+        row,
+        world_ray,
+        hit,
+        background,
+        normal_transform,
+    } = story;
+    ui.label(format!("Pixel ({x}, {row}), rows from the top"));
+    ui.label(format!(
+        "World ray: origin {} direction {}",
+        v(world_ray.origin),
+        v(world_ray.direction)
+    ));
+    let Some(h) = hit else {
+        ui.label(format!(
+            "Missed every object: background {}",
+            v(*background)
+        ));
+        return;
+    };
+    ui.separator();
+    ui.strong(format!(
+        "Hit {} (node #{}) at t = {:.5}",
+        scene.graph.get(h.node).map_or("?", |n| n.kind.name()),
+        h.node.0,
+        h.t
+    ));
+    ui.label("Path, with the ray in each space (t is the same in every one):");
+    egui::Grid::new("path").striped(true).show(ui, |ui| {
+        for step in &h.path {
+            let what = match scene.graph.get(step.node).map(|n| &n.kind) {
+                Some(NodeKind::Transform(ops)) => {
+                    format!(
+                        "Transform: {}",
+                        ops.iter()
+                            .map(|o| o.summary())
+                            .collect::<Vec<_>>()
+                            .join(" · ")
+                    )
+                }
+                _ => step.kind.to_string(),
+            };
+            ui.label(what);
+            ui.label(format!(
+                "o {}  d {}",
+                v(step.ray.origin),
+                v(step.ray.direction)
+            ));
+            ui.end_row();
+        }
+    });
+    ui.separator();
+    egui::Grid::new("hit").show(ui, |ui| {
+        let mut row = |a: &str, b: String| {
+            ui.label(a);
+            ui.label(b);
+            ui.end_row();
+        };
+        row("hit point (object)", v(h.object_point));
+        row("hit point (world)", v(h.world_point));
+        row("normal (object)", v(h.object_normal));
+        row("world normal by (M^-1)^T", v(h.normal_correct));
+        row("world normal by M", v(h.normal_incorrect));
+        row(
+            "angle between them",
+            format!("{:.3}°", h.normal_angle_degrees),
+        );
+        let rule = match normal_transform {
+            NormalTransform::Correct => "(M^-1)^T",
+            NormalTransform::Incorrect => "M",
+        };
+        row(
+            "shading uses",
+            format!(
+                "{rule}{}",
+                if h.shade.back_facing {
+                    ", back-facing"
+                } else {
+                    ""
+                }
+            ),
+        );
+        row("diffuse k_d", v(h.shade.diffuse));
+        row("ambient · k_d", v(h.shade.ambient_term));
+        for (i, l) in h.shade.lights.iter().enumerate() {
+            row(&format!("light {i}: L·N"), format!("{:.4}", l.l_dot_n));
+            row(&format!("light {i}: max(L·N,0)·c·k_d"), v(l.contribution));
+        }
+        row("colour (sum)", v(h.shade.color));
+    });
+}

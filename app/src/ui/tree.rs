@@ -1,0 +1,317 @@
+//! The scene tree (left panel). The scene is first walked into plain rows (testable without
+//! a UI), then drawn; clicks and toolbar buttons become selections and [`Edit`]s.
+
+use glam::Vec3;
+use tracelab_core::{MeshSlot, NodeId, NodeKind, Scene, TransformOp};
+
+use crate::edit::Edit;
+use crate::state::{Document, Selection};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeRow {
+    pub id: NodeId,
+    pub depth: usize,
+    /// e.g. `Transform: Translate(1, 0.5, 0) · Scale(2, 2, 2)`
+    pub label: String,
+    /// Material the node renders with (`None`: the default material).
+    pub material: Option<u32>,
+    pub error: Option<String>,
+}
+
+/// A short summary of a node for its tree row.
+pub fn node_label(kind: &NodeKind, children: usize) -> String {
+    let v = |v: Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
+    match kind {
+        NodeKind::Group => format!("Group ({children})"),
+        NodeKind::Transform(ops) if ops.is_empty() => "Transform: identity".into(),
+        NodeKind::Transform(ops) => {
+            format!(
+                "Transform: {}",
+                ops.iter()
+                    .map(TransformOp::summary)
+                    .collect::<Vec<_>>()
+                    .join(" · ")
+            )
+        }
+        NodeKind::Sphere { center, radius } => format!("Sphere: ({}) r {radius}", v(*center)),
+        NodeKind::Plane { normal, offset } => format!("Plane: n ({}) d {offset}", v(*normal)),
+        NodeKind::Triangle { .. } => "Triangle".into(),
+        NodeKind::TriangleMesh { obj_file, mesh } => match mesh {
+            MeshSlot::Loaded(m) => {
+                format!("TriangleMesh: {obj_file} ({} tris)", m.triangle_count())
+            }
+            MeshSlot::Failed(_) => format!("TriangleMesh: {obj_file} (not loaded)"),
+        },
+        #[allow(unreachable_patterns)]
+        other => other.name().to_string(),
+    }
+}
+
+/// The object hierarchy as rows, parents first.
+pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
+    let g = &scene.graph;
+    let mats = g.effective_materials();
+    let mut rows = Vec::new();
+    let mut stack = vec![(g.root(), 0usize)];
+    while let Some((id, depth)) = stack.pop() {
+        let Some(n) = g.get(id) else { continue };
+        let error = match &n.kind {
+            NodeKind::TriangleMesh {
+                mesh: MeshSlot::Failed(e),
+                ..
+            } => Some(e.clone()),
+            _ => None,
+        };
+        rows.push(TreeRow {
+            id,
+            depth,
+            label: node_label(&n.kind, n.children.len()),
+            material: mats.get(id.index()).copied().flatten(),
+            error,
+        });
+        for &c in n.children.iter().rev() {
+            stack.push((c, depth + 1));
+        }
+    }
+    rows
+}
+
+/// Draws the tree; returns the edits asked for. `reveal` scrolls that node's row into view
+/// (when it was selected elsewhere, e.g. by clicking the render).
+pub fn ui(
+    ui: &mut egui::Ui,
+    doc: &mut Document,
+    rows: &[TreeRow],
+    reveal: Option<NodeId>,
+) -> Vec<Edit> {
+    let mut edits = Vec::new();
+    toolbar(ui, doc, &mut edits);
+    ui.separator();
+    let sel = doc.selection;
+    let mut clicked = None;
+    {
+        let mut item = |ui: &mut egui::Ui, s: Selection, text: String| {
+            if ui.selectable_label(sel == Some(s), text).clicked() {
+                clicked = Some(s);
+            }
+        };
+        item(ui, Selection::Camera, camera_label(&doc.scene));
+        item(
+            ui,
+            Selection::Lights,
+            format!("Lights ({})", doc.scene.lights().len()),
+        );
+        for i in 0..doc.scene.lights().len() {
+            ui.horizontal(|ui| {
+                ui.add_space(14.0);
+                item(ui, Selection::Light(i), format!("Light {i}"));
+            });
+        }
+        item(ui, Selection::Background, "Background".into());
+        item(
+            ui,
+            Selection::Materials,
+            format!("Materials ({})", doc.scene.materials.len()),
+        );
+        for (i, m) in doc.scene.materials.iter().enumerate() {
+            ui.horizontal(|ui| {
+                ui.add_space(14.0);
+                swatch(ui, m.diffuse);
+                item(ui, Selection::Material(i), format!("Material {i}"));
+            });
+        }
+        ui.separator();
+        let row_h = ui.spacing().interact_size.y;
+        // Only visible rows are laid out: meshes and generated scenes can have many nodes.
+        // Scrolls sideways too, so long summaries do not widen the panel.
+        let mut area = egui::ScrollArea::both()
+            .id_salt("objects")
+            .auto_shrink([false, false]);
+        if let Some(i) = reveal.and_then(|id| rows.iter().position(|r| r.id == id)) {
+            let step = row_h + ui.spacing().item_spacing.y;
+            area = area.vertical_scroll_offset(((i as f32 - 3.0) * step).max(0.0));
+        }
+        area.show_rows(ui, row_h, rows.len(), |ui, range| {
+            for row in &rows[range] {
+                ui.horizontal(|ui| {
+                    ui.add_space(row.depth as f32 * 14.0);
+                    if let Some(mat) = row
+                        .material
+                        .and_then(|m| doc.scene.materials.get(m as usize))
+                    {
+                        swatch(ui, mat.diffuse);
+                    }
+                    let mut text = row.label.clone();
+                    if let Some(m) = row.material {
+                        text.push_str(&format!("  [mat {m}]"));
+                    }
+                    let s = Selection::Node(row.id);
+                    let mut label = egui::RichText::new(text);
+                    if row.error.is_some() {
+                        label = label.color(ui.visuals().error_fg_color);
+                    }
+                    let r = ui.selectable_label(sel == Some(s), label);
+                    let r = match &row.error {
+                        Some(e) => r.on_hover_text(e),
+                        None => r,
+                    };
+                    if r.clicked() {
+                        clicked = Some(s);
+                    }
+                });
+            }
+        });
+    }
+    if let Some(s) = clicked {
+        doc.selection = Some(s);
+    }
+    edits
+}
+
+fn camera_label(scene: &Scene) -> String {
+    match scene.camera {
+        tracelab_core::Camera::Orthographic { .. } => "Camera (orthographic)".into(),
+        tracelab_core::Camera::Perspective { .. } => "Camera (perspective)".into(),
+    }
+}
+
+fn swatch(ui: &mut egui::Ui, c: Vec3) {
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(10.0, 10.0), egui::Sense::hover());
+    ui.painter().rect_filled(rect, 2.0, crate::ui::color32(c));
+}
+
+/// The Group new objects go into: the selected Group, or the Group holding the selection.
+fn target_group(doc: &Document) -> NodeId {
+    let g = &doc.scene.graph;
+    let Some(Selection::Node(id)) = doc.selection else {
+        return g.root();
+    };
+    let path = g.path_to(id).unwrap_or_default();
+    path.iter()
+        .rev()
+        .copied()
+        .find(|&p| matches!(g.get(p).map(|n| &n.kind), Some(NodeKind::Group)))
+        .unwrap_or(g.root())
+}
+
+fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
+    let parent = target_group(doc);
+    let selected = match doc.selection {
+        Some(Selection::Node(id)) if id != doc.scene.graph.root() => Some(id),
+        _ => None,
+    };
+    ui.horizontal_wrapped(|ui| {
+        ui.menu_button("Add", |ui| {
+            let kinds: [(&str, NodeKind); 6] = [
+                (
+                    "Sphere",
+                    NodeKind::Sphere {
+                        center: Vec3::ZERO,
+                        radius: 1.0,
+                    },
+                ),
+                (
+                    "Plane",
+                    NodeKind::Plane {
+                        normal: Vec3::Y,
+                        offset: -1.0,
+                    },
+                ),
+                (
+                    "Triangle",
+                    NodeKind::Triangle {
+                        vertices: [
+                            Vec3::new(-1.0, 0.0, 0.0),
+                            Vec3::new(1.0, 0.0, 0.0),
+                            Vec3::new(0.0, 1.5, 0.0),
+                        ],
+                    },
+                ),
+                (
+                    "TriangleMesh",
+                    NodeKind::TriangleMesh {
+                        obj_file: String::new(),
+                        mesh: MeshSlot::Failed("no OBJ file chosen yet".into()),
+                    },
+                ),
+                ("Group", NodeKind::Group),
+                (
+                    "Transform",
+                    NodeKind::Transform(vec![TransformOp::Translate(Vec3::ZERO)]),
+                ),
+            ];
+            for (name, kind) in kinds {
+                if ui.button(name).clicked() {
+                    edits.push(Edit::AddNode { parent, kind });
+                    ui.close();
+                }
+            }
+        });
+        ui.add_enabled_ui(selected.is_some(), |ui| {
+            let Some(node) = selected.or(Some(doc.scene.graph.root())) else {
+                return;
+            };
+            if ui.button("Delete").on_hover_text("Delete (Del)").clicked() {
+                edits.push(Edit::DeleteNode { node });
+            }
+            if ui.button("Duplicate").clicked() {
+                edits.push(Edit::DuplicateNode { node });
+            }
+            if ui.button("Wrap in Transform").clicked() {
+                edits.push(Edit::WrapInTransform { node });
+            }
+            if ui.button("Wrap in Group").clicked() {
+                edits.push(Edit::WrapInGroup { node });
+            }
+            let g = &doc.scene.graph;
+            let parents = g.parents();
+            // Up/down move the node's slot (itself or the Transform holding it) in its Group.
+            let mut slot = node;
+            while let Some(p) = parents.get(slot.index()).copied().flatten() {
+                if matches!(g.node(p).kind, NodeKind::Group) {
+                    let pos = g
+                        .node(p)
+                        .children
+                        .iter()
+                        .position(|&c| c == slot)
+                        .unwrap_or(0);
+                    if ui.button("Up").clicked() && pos > 0 {
+                        edits.push(Edit::MoveNode {
+                            node,
+                            new_parent: p,
+                            index: pos - 1,
+                        });
+                    }
+                    if ui.button("Down").clicked() && pos + 1 < g.node(p).children.len() {
+                        edits.push(Edit::MoveNode {
+                            node,
+                            new_parent: p,
+                            index: pos + 2,
+                        });
+                    }
+                    break;
+                }
+                slot = p;
+            }
+            ui.menu_button("Move to", |ui| {
+                for (id, n) in g.iter() {
+                    if matches!(n.kind, NodeKind::Group) {
+                        let name = if id == g.root() {
+                            "root Group".to_string()
+                        } else {
+                            format!("Group #{}", id.0)
+                        };
+                        if ui.button(name).clicked() {
+                            edits.push(Edit::MoveNode {
+                                node,
+                                new_parent: id,
+                                index: usize::MAX,
+                            });
+                            ui.close();
+                        }
+                    }
+                }
+            });
+        });
+    });
+}

@@ -1,0 +1,389 @@
+//! The render view (centre): view tabs, the normal-transform switch, compare modes, depth
+//! range and size controls, the images themselves (uploaded as textures when the worker has
+//! new pixels), and picking.
+
+use tracelab_core::{NormalTransform, RenderSettings, View};
+
+use crate::render_worker::{Published, RenderWorker};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tab {
+    Color,
+    Normals,
+    Depth,
+    All,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    Off,
+    SideBySide,
+    Split,
+}
+
+/// View settings (persisted between runs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    pub tab: Tab,
+    pub compare: Compare,
+    pub normal_transform: NormalTransform,
+    pub shade_back: bool,
+    pub depth: (f32, f32),
+    /// `None`: follow the view's size in pixels.
+    pub fixed_size: Option<(u32, u32)>,
+    /// Split position in compare-split mode, 0..1 from the left.
+    pub split: f32,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            tab: Tab::Color,
+            compare: Compare::Off,
+            normal_transform: NormalTransform::Correct,
+            shade_back: false,
+            depth: (8.0, 18.0),
+            fixed_size: None,
+            split: 0.5,
+        }
+    }
+}
+
+impl ViewSettings {
+    /// The renders needed: one, or both rules when comparing.
+    pub fn modes(&self) -> Vec<NormalTransform> {
+        match self.compare {
+            Compare::Off => vec![self.normal_transform],
+            _ => vec![NormalTransform::Correct, NormalTransform::Incorrect],
+        }
+    }
+
+    /// (frame index, view, caption) for each image cell.
+    pub fn cells(&self) -> Vec<(usize, View, &'static str)> {
+        let single = match self.tab {
+            Tab::Color => View::Color,
+            Tab::Normals | Tab::All => View::Normals,
+            Tab::Depth => View::Depth,
+        };
+        match (self.compare, self.tab) {
+            (Compare::Off, Tab::All) => {
+                vec![
+                    (0, View::Color, "Colour"),
+                    (0, View::Normals, "Normals"),
+                    (0, View::Depth, "Depth"),
+                ]
+            }
+            (Compare::Off, _) => vec![(0, single, "")],
+            (Compare::SideBySide, _) => vec![
+                (0, single, "Correct: (M^-1)^T n"),
+                (1, single, "Incorrect: M n"),
+            ],
+            // Split draws both frames into one cell.
+            (Compare::Split, _) => vec![(0, single, "Correct (left) | Incorrect (right)")],
+        }
+    }
+}
+
+/// What a click in the view asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pick {
+    pub frame: usize,
+    pub x: u32,
+    pub row: u32,
+}
+
+/// (generation, frame version, view, depth range bits): what a texture holds.
+type UploadKey = (u64, u64, View, (u32, u32));
+
+/// Texture state: what is on the GPU, so unchanged pixels are not uploaded again.
+#[derive(Default)]
+pub struct Viewport {
+    textures: Vec<Option<egui::TextureHandle>>,
+    /// Per texture: (generation, frame version, view, depth range) last uploaded.
+    uploaded: Vec<Option<UploadKey>>,
+    /// Size of the image shown, in pixels.
+    pub shown_size: (u32, u32),
+    /// The pixel being inspected, marked in every image.
+    pub marker: Option<(u32, u32)>,
+    /// Generation of the image on screen, for the edit→screen timing log.
+    shown_generation: u64,
+}
+
+impl Viewport {
+    /// The toolbar; returns true when a setting changed.
+    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings) {
+        ui.horizontal_wrapped(|ui| {
+            for (tab, name) in [
+                (Tab::Color, "Colour"),
+                (Tab::Normals, "Normals"),
+                (Tab::Depth, "Depth"),
+                (Tab::All, "All three"),
+            ] {
+                ui.selectable_value(&mut s.tab, tab, name);
+            }
+            ui.separator();
+            ui.label("Normal transform:");
+            // Compare mode shows both rules, so the switch has nothing to choose there.
+            ui.add_enabled_ui(s.compare == Compare::Off, |ui| {
+                ui.selectable_value(
+                    &mut s.normal_transform,
+                    NormalTransform::Correct,
+                    "Correct (M^-1)^T",
+                );
+                ui.selectable_value(
+                    &mut s.normal_transform,
+                    NormalTransform::Incorrect,
+                    "Incorrect M",
+                );
+            });
+            ui.separator();
+            egui::ComboBox::from_label("compare")
+                .selected_text(match s.compare {
+                    Compare::Off => "off",
+                    Compare::SideBySide => "side by side",
+                    Compare::Split => "split",
+                })
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut s.compare, Compare::Off, "off");
+                    ui.selectable_value(&mut s.compare, Compare::SideBySide, "side by side");
+                    ui.selectable_value(&mut s.compare, Compare::Split, "split");
+                });
+        });
+        ui.horizontal_wrapped(|ui| {
+            ui.checkbox(&mut s.shade_back, "shade back");
+            ui.separator();
+            ui.label("depth");
+            ui.add(
+                egui::DragValue::new(&mut s.depth.0)
+                    .speed(0.05)
+                    .prefix("min "),
+            );
+            ui.add(
+                egui::DragValue::new(&mut s.depth.1)
+                    .speed(0.05)
+                    .prefix("max "),
+            );
+            ui.separator();
+            let mut fixed = s.fixed_size.is_some();
+            if ui.checkbox(&mut fixed, "fixed size").changed() {
+                s.fixed_size = fixed.then_some((200, 200));
+            }
+            if let Some((w, h)) = &mut s.fixed_size {
+                ui.add(egui::DragValue::new(w).range(1..=4096).suffix(" w"));
+                ui.add(egui::DragValue::new(h).range(1..=4096).suffix(" h"));
+            }
+        });
+    }
+
+    /// The render size for the space available (in points), per the settings.
+    pub fn render_size(s: &ViewSettings, avail: egui::Vec2, pixels_per_point: f32) -> (u32, u32) {
+        if let Some(size) = s.fixed_size {
+            return size;
+        }
+        let n = match (s.compare, s.tab) {
+            (Compare::Off, Tab::All) => 3.0,
+            (Compare::SideBySide, _) => 2.0,
+            _ => 1.0,
+        };
+        let caption = if n > 1.0 { 18.0 } else { 0.0 };
+        let w = (avail.x / n - 4.0).max(8.0) * pixels_per_point;
+        let h = (avail.y - caption).max(8.0) * pixels_per_point;
+        (w as u32, h as u32)
+    }
+
+    /// Draws the images and returns a pick when the user clicked a pixel.
+    pub fn images(
+        &mut self,
+        ui: &mut egui::Ui,
+        s: &mut ViewSettings,
+        worker: &RenderWorker,
+    ) -> Option<Pick> {
+        let cells = s.cells();
+        let ctx = ui.ctx().clone();
+        let mut pick = None;
+        worker.with_published(|p| {
+            let Some(p) = p else {
+                ui.label("Rendering…");
+                return;
+            };
+            self.upload(&ctx, p, s);
+        });
+        let avail = ui.available_size();
+        let n = cells.len() as f32;
+        // Cells sit item_spacing apart; leave room for the gaps so the last one fits.
+        let gap = ui.spacing().item_spacing.x;
+        let cell_w = ((avail.x - gap * (n - 1.0)) / n).floor();
+        let ppp = ui.pixels_per_point();
+        ui.horizontal_top(|ui| {
+            for (ci, &(frame, view, caption)) in cells.iter().enumerate() {
+                let (cell, resp) = ui.allocate_exact_size(
+                    egui::vec2(cell_w, avail.y),
+                    egui::Sense::click_and_drag(),
+                );
+                let mut img_area = cell;
+                if !caption.is_empty() {
+                    ui.painter().text(
+                        cell.left_top() + egui::vec2(4.0, 2.0),
+                        egui::Align2::LEFT_TOP,
+                        caption,
+                        egui::FontId::proportional(13.0),
+                        ui.visuals().text_color(),
+                    );
+                    img_area.min.y += 18.0;
+                }
+                let tex_i = self.tex_index(frame, view);
+                let Some(Some(tex)) = self.textures.get(tex_i) else {
+                    continue;
+                };
+                let [w, h] = tex.size();
+                // View-sized renders show 1:1 (or scaled down to fit); a fixed size (say the
+                // handout's 200×200) is scaled up to fill the view, pixels kept sharp.
+                let size = egui::vec2(w as f32, h as f32) / ppp;
+                let fit = (img_area.width() / size.x).min(img_area.height() / size.y);
+                let scale = if s.fixed_size.is_some() {
+                    fit
+                } else {
+                    fit.min(1.0)
+                };
+                let rect = egui::Rect::from_center_size(img_area.center(), size * scale);
+                let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                if s.compare == Compare::Split {
+                    let other = self
+                        .textures
+                        .get(self.tex_index(1, view))
+                        .and_then(Option::as_ref);
+                    let xs = rect.left() + rect.width() * s.split;
+                    let left = egui::Rect::from_min_max(rect.min, egui::pos2(xs, rect.max.y));
+                    let right = egui::Rect::from_min_max(egui::pos2(xs, rect.min.y), rect.max);
+                    let luv =
+                        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(s.split, 1.0));
+                    let ruv =
+                        egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
+                    ui.painter()
+                        .image(tex.id(), left, luv, egui::Color32::WHITE);
+                    if let Some(o) = other {
+                        ui.painter().image(o.id(), right, ruv, egui::Color32::WHITE);
+                    }
+                    ui.painter().vline(
+                        xs,
+                        rect.y_range(),
+                        egui::Stroke::new(2.0, egui::Color32::YELLOW),
+                    );
+                    if resp.dragged()
+                        && let Some(pos) = resp.interact_pointer_pos()
+                    {
+                        s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
+                    }
+                } else {
+                    ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
+                }
+                let _ = ci;
+                if let Some((mx, my)) = self.marker {
+                    let c = rect.min
+                        + egui::vec2(
+                            (mx as f32 + 0.5) / w as f32 * rect.width(),
+                            (my as f32 + 0.5) / h as f32 * rect.height(),
+                        );
+                    let stroke = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 0, 255));
+                    ui.painter().circle_stroke(c, 6.0, stroke);
+                    ui.painter().hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
+                    ui.painter().hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
+                    ui.painter().vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
+                    ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
+                }
+                if resp.clicked()
+                    && let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p))
+                {
+                    let u = (pos.x - rect.left()) / rect.width();
+                    let v = (pos.y - rect.top()) / rect.height();
+                    let frame = if s.compare == Compare::Split && u > s.split {
+                        1
+                    } else {
+                        frame
+                    };
+                    let x = ((u * w as f32) as u32).min(w as u32 - 1);
+                    let row = ((v * h as f32) as u32).min(h as u32 - 1);
+                    pick = Some(Pick { frame, x, row });
+                }
+            }
+        });
+        pick
+    }
+
+    fn tex_index(&self, frame: usize, view: View) -> usize {
+        frame * 3
+            + match view {
+                View::Color => 0,
+                View::Normals => 1,
+                View::Depth => 2,
+            }
+    }
+
+    /// Uploads the views the cells need whenever their pixels changed. The previous image
+    /// stays until a new render has completed its first (coarse) pass.
+    fn upload(&mut self, ctx: &egui::Context, p: &Published, s: &ViewSettings) {
+        if p.passes_done == 0 {
+            return;
+        }
+        let mut need: Vec<(usize, View)> = s.cells().iter().map(|&(f, v, _)| (f, v)).collect();
+        if s.compare == Compare::Split {
+            need.extend(s.cells().iter().map(|&(_, v, _)| (1, v)));
+        }
+        for (frame_i, view) in need {
+            let Some(frame) = p.frames.get(frame_i) else {
+                continue;
+            };
+            let i = self.tex_index(frame_i, view);
+            if self.textures.len() <= i {
+                self.textures.resize_with(i + 1, || None);
+                self.uploaded.resize(i + 1, None);
+            }
+            let depth_key = (s.depth.0.to_bits(), s.depth.1.to_bits());
+            let key = Some((p.job.generation, frame.version(), view, depth_key));
+            if self.uploaded[i] == key {
+                continue;
+            }
+            let (w, h, rgba) = {
+                let f = frame.lock();
+                (f.width, f.height, f.rgba8(view, s.depth))
+            };
+            if w == 0 || h == 0 {
+                continue;
+            }
+            let image = egui::ColorImage::from_rgba_unmultiplied([w as usize, h as usize], &rgba);
+            match &mut self.textures[i] {
+                Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+                slot => {
+                    *slot = Some(ctx.load_texture(
+                        format!("view-{i}"),
+                        image,
+                        egui::TextureOptions::NEAREST,
+                    ))
+                }
+            }
+            self.uploaded[i] = key;
+            self.shown_size = (w, h);
+        }
+        if p.job.generation != self.shown_generation {
+            self.shown_generation = p.job.generation;
+            if std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0") {
+                eprintln!(
+                    "tracelab: generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
+                    p.job.generation,
+                    p.job.submitted.elapsed().as_secs_f64() * 1e3,
+                    ctx.input(|i| i.unstable_dt) * 1e3
+                );
+            }
+        }
+    }
+
+    /// The settings the worker should render with.
+    pub fn settings(s: &ViewSettings, size: (u32, u32)) -> RenderSettings {
+        RenderSettings {
+            width: size.0.max(1),
+            height: size.1.max(1),
+            shade_back: s.shade_back,
+            normal_transform: s.normal_transform,
+        }
+    }
+}

@@ -1,0 +1,506 @@
+//! Logic tests of the editor window with egui_kittest: they find widgets by label, click and
+//! set values as a user would, and check the document and the renderer. No GPU needed.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::Vec3;
+use tracelab::app::{AppOptions, Pending, TracelabApp};
+use tracelab::state::Selection;
+use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+fn shared_scene(name: &str) -> Option<PathBuf> {
+    let p = repo("../shared/mit6837/scenes").join(name);
+    if p.is_file() {
+        return Some(p);
+    }
+    assert!(
+        std::env::var_os("TRACELAB_REQUIRE_SHARED").is_none(),
+        "../shared/mit6837 is required here"
+    );
+    eprintln!("SKIPPED: {} is not there (../shared absent)", p.display());
+    None
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tracelab-gui-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+fn harness(scene: Option<PathBuf>, size: (u32, u32)) -> Harness<'static, TracelabApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene,
+                    fixed_size: Some(size),
+                },
+            )
+        })
+}
+
+/// Steps the UI until the renderer has finished the newest request.
+fn settle(h: &mut Harness<'static, TracelabApp>) {
+    let start = Instant::now();
+    loop {
+        h.step();
+        if h.state().worker.is_idle() {
+            // One more frame uploads the last pixels.
+            h.step();
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "render did not finish"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// The first Transform in the scene whose first op is a Translate.
+fn translate_transform(app: &TracelabApp) -> (NodeId, Vec3) {
+    app.doc
+        .scene
+        .graph
+        .iter()
+        .find_map(|(id, n)| match &n.kind {
+            NodeKind::Transform(ops) => match ops.first() {
+                Some(TransformOp::Translate(t)) => Some((id, *t)),
+                _ => None,
+            },
+            _ => None,
+        })
+        .expect("a Transform starting with Translate")
+}
+
+/// Select a Transform in the tree, change its Translate x in the inspector, check the
+/// document and the render, save and read back, undo.
+fn edit_save_undo(scene: PathBuf) {
+    let mut h = harness(Some(scene.clone()), (48, 48));
+    settle(&mut h);
+    assert!(
+        h.state().doc.messages.iter().all(|m| m.contains("warning")),
+        "{:?}",
+        h.state().doc.messages
+    );
+    let original = h.state().doc.scene.clone();
+    let (id, t) = translate_transform(h.state());
+
+    let label = tracelab::ui::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    h.get_all_by_label_contains(&label)
+        .next()
+        .expect("tree row")
+        .click();
+    h.step();
+    assert_eq!(h.state().doc.selection, Some(Selection::Node(id)));
+
+    let gen_before = h.state().doc.generation;
+    let worker_before = h.state().worker.last_generation();
+    let new_x = t.x + 0.75;
+    h.get_by_label("Translate x")
+        .set_value_accesskit(f64::from(new_x));
+    h.step();
+    h.step();
+    let app = h.state();
+    let NodeKind::Transform(ops) = &app.doc.scene.graph.node(id).kind else {
+        panic!("still a Transform")
+    };
+    assert_eq!(ops[0], TransformOp::Translate(Vec3::new(new_x, t.y, t.z)));
+    assert!(app.doc.generation > gen_before, "the document changed");
+    assert!(app.doc.is_dirty());
+    assert!(
+        app.worker.last_generation() > worker_before,
+        "the render restarted"
+    );
+    settle(&mut h);
+    let shown = h
+        .state()
+        .worker
+        .with_published(|p| p.map(|p| p.job.generation));
+    assert_eq!(
+        shown,
+        Some(h.state().doc.generation),
+        "the image shows the edited scene"
+    );
+
+    let out = temp_dir("save").join(scene.file_name().expect("name"));
+    h.state_mut().save_as(&out);
+    assert!(!h.state().doc.is_dirty());
+    let back = tracelab_core::load_scene(&out, &mut MeshCache::new())
+        .into_result()
+        .expect("saved file reads back")
+        .0;
+    let found = back.graph.iter().any(|(_, n)| {
+        matches!(&n.kind, NodeKind::Transform(ops) if ops.first() == Some(&TransformOp::Translate(Vec3::new(new_x, t.y, t.z))))
+    });
+    assert!(found, "saved file holds the new Translate");
+
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert_eq!(
+        h.state().doc.scene,
+        original,
+        "undo restores the identical document"
+    );
+    let _ = std::fs::remove_file(&out);
+}
+
+#[test]
+fn course_scene_edit_save_and_undo() {
+    let Some(scene) = shared_scene("scene2_16_t_scale.txt") else {
+        return;
+    };
+    edit_save_undo(scene);
+}
+
+#[test]
+fn own_scene_edit_save_and_undo() {
+    edit_save_undo(repo("scenes/nested_transforms.txt"));
+}
+
+#[test]
+fn syntax_error_shows_its_location_and_keeps_the_scene() {
+    let mut h = harness(None, (32, 32));
+    settle(&mut h);
+    let before = h.state().doc.scene.clone();
+    let bad = temp_dir("bad").join("broken.txt");
+    std::fs::write(
+        &bad,
+        "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 oops\n}\n",
+    )
+    .expect("write");
+    h.state_mut().open(&bad);
+    h.step();
+    h.step();
+    assert_eq!(h.state().doc.scene, before, "the previous scene stays open");
+    let msg = h.state().doc.messages.join("\n");
+    assert!(msg.contains("broken.txt:3:"), "{msg}");
+    // Shown in the window, with file:line:col.
+    let _ = h.get_by_label_contains("broken.txt:3:");
+    // And the app keeps working.
+    settle(&mut h);
+}
+
+const SPHERE_SCENE: &str = "
+OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }
+Lights { numLights 1 DirectionalLight { direction -0.2 -0.2 -1 color 1 1 1 } }
+Background { color 0.2 0 0.6 ambientLight 0 0 0 }
+Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }
+Group { numObjects 1 MaterialIndex 0
+  Transform { OP Sphere { center 0 0 0 radius 1 } } }
+";
+
+/// Normal-view bytes with the switch on Correct, then on Incorrect (clicked in the UI).
+fn normals_both_ways(op: &str, tag: &str) -> (Vec<u8>, Vec<u8>) {
+    let path = temp_dir(tag).join("sphere.txt");
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", op)).expect("write");
+    let mut h = harness(Some(path), (40, 40));
+    h.state_mut().view.tab = tracelab::ui::viewport::Tab::Normals;
+    settle(&mut h);
+    let grab = |h: &Harness<'static, TracelabApp>| {
+        h.state().worker.with_published(|p| {
+            p.expect("rendered").frames[0]
+                .lock()
+                .rgb8(View::Normals, (0.0, 1.0))
+        })
+    };
+    let correct = grab(&h);
+    h.get_by_label("Incorrect M").click();
+    h.step();
+    settle(&mut h);
+    assert_eq!(
+        h.state().view.normal_transform,
+        tracelab_core::NormalTransform::Incorrect
+    );
+    (correct, grab(&h))
+}
+
+#[test]
+fn normal_switch_changes_a_squashed_sphere_and_not_a_plain_one() {
+    let (c, i) = normals_both_ways("Scale 1 0.2 1", "squashed");
+    let differ = c.chunks(3).zip(i.chunks(3)).filter(|(a, b)| a != b).count();
+    assert!(differ > 50, "only {differ} pixels changed");
+    let (c, i) = normals_both_ways("UniformScale 0.8", "plain");
+    assert_eq!(c, i, "a uniformly scaled sphere looks the same either way");
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_first() {
+    let mut h = harness(None, (32, 32));
+    settle(&mut h);
+    let (id, t) = translate_transform(h.state());
+    h.state_mut().apply(tracelab::edit::Edit::SetTransformOp {
+        node: id,
+        index: 0,
+        op: TransformOp::Translate(t + Vec3::X),
+    });
+    h.step();
+    h.input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    h.step();
+    h.step();
+    assert_eq!(h.state().confirm, Some(Pending::Close));
+    h.get_by_label("Cancel").click();
+    h.step();
+    assert_eq!(h.state().confirm, None);
+    assert!(h.state().doc.is_dirty(), "cancel keeps the edits");
+}
+
+#[test]
+fn clicking_a_pixel_selects_its_node_and_tells_the_ray_story() {
+    let mut h = harness(None, (64, 48));
+    settle(&mut h);
+    // A pixel showing an object that sits under a Transform (the built-in scene has several).
+    let pixel = h.state().worker.with_published(|p| {
+        let p = p.expect("rendered");
+        let f = p.frames[0].lock();
+        let g = &h.state().doc.scene.graph;
+        (0..f.height)
+            .flat_map(|row| (0..f.width).map(move |x| (x, row)))
+            .find(|&(x, row)| {
+                let s = f.get(x, row).expect("in frame");
+                s.is_hit()
+                    && g.path_to(NodeId(s.node)).is_some_and(|path| {
+                        path.iter()
+                            .any(|&id| matches!(g.node(id).kind, NodeKind::Transform(_)))
+                    })
+            })
+    });
+    let (x, row) = pixel.expect("some pixel shows a transformed object");
+    h.state_mut().inspect(0, x, row);
+    // A new window lays itself out in its first frame and shows in the next.
+    for _ in 0..3 {
+        h.step();
+    }
+    let app = h.state();
+    let (story, _) = app.story.as_ref().expect("a story");
+    let hit = story.hit.as_ref().expect("the ray hits something");
+    assert_eq!(app.doc.selection, Some(Selection::Node(hit.node)));
+    assert!(hit.path.iter().any(|s| s.kind == "Transform"));
+    let _ = h.get_by_label_contains("world normal by (M^-1)^T");
+}
+
+#[test]
+fn recent_files_and_view_settings_persist() {
+    struct Mem(std::collections::HashMap<String, String>);
+    impl eframe::Storage for Mem {
+        fn get_string(&self, key: &str) -> Option<String> {
+            self.0.get(key).cloned()
+        }
+        fn set_string(&mut self, key: &str, value: String) {
+            self.0.insert(key.into(), value);
+        }
+        fn remove_string(&mut self, key: &str) {
+            self.0.remove(key);
+        }
+        fn flush(&mut self) {}
+    }
+    let mut a = TracelabApp::new(None, AppOptions::default());
+    assert!(a.open_now(&repo("scenes/hierarchy.txt")));
+    a.view.tab = tracelab::ui::viewport::Tab::Depth;
+    a.view.depth = (3.0, 12.5);
+    let mut m = Mem(Default::default());
+    eframe::App::save(&mut a, &mut m);
+    let mut b = TracelabApp::new(None, AppOptions::default());
+    b.load_persisted(&m);
+    assert_eq!(b.recent, vec![repo("scenes/hierarchy.txt")]);
+    assert_eq!(b.view.tab, tracelab::ui::viewport::Tab::Depth);
+    assert_eq!(b.view.depth, (3.0, 12.5));
+}
+
+#[test]
+fn export_all_three_writes_every_view() {
+    let mut h = harness(None, (32, 24));
+    h.state_mut().view.tab = tracelab::ui::viewport::Tab::All;
+    settle(&mut h);
+    let out = temp_dir("export").join("shot.png");
+    let files = h.state_mut().export(&out).expect("exports");
+    assert_eq!(files.len(), 3);
+    for f in &files {
+        let img = image::open(f).expect("readable").to_rgb8();
+        assert_eq!(img.dimensions(), (32, 24));
+    }
+    let names: Vec<String> = files
+        .iter()
+        .map(|f| {
+            f.file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(
+        names,
+        ["shot_color.png", "shot_normals.png", "shot_depth.png"]
+    );
+}
+
+#[test]
+fn a_file_changed_on_disk_is_reloaded() {
+    let path = temp_dir("reload").join("sphere.txt");
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", "UniformScale 1")).expect("write");
+    let mut h = harness(Some(path.clone()), (16, 16));
+    settle(&mut h);
+    // Someone edits the file in a text editor beside the app.
+    std::thread::sleep(Duration::from_millis(20));
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", "UniformScale 0.5")).expect("write");
+    let start = Instant::now();
+    loop {
+        h.step();
+        let reloaded = h.state().doc.scene.graph.iter().any(|(_, n)| {
+            matches!(&n.kind, NodeKind::Transform(ops) if ops.first() == Some(&TransformOp::UniformScale(0.5)))
+        });
+        if reloaded {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(5), "not reloaded");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(!h.state().doc.is_dirty());
+}
+
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn a_scene_dropped_on_the_window_opens() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    let path = repo("scenes/hierarchy.txt");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(path.clone())));
+    h.step();
+    assert_eq!(h.state().doc.path.as_deref(), Some(path.as_path()));
+    assert_eq!(h.state().recent.first(), Some(&path));
+}
+
+#[test]
+fn opening_over_unsaved_changes_asks_and_discard_opens() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(
+        tracelab_core::Material::diffuse(Vec3::ONE),
+    ));
+    let target = repo("scenes/hierarchy.txt");
+    h.state_mut().open(&target);
+    for _ in 0..3 {
+        h.step();
+    }
+    assert_eq!(h.state().confirm, Some(Pending::Open(target.clone())));
+    assert_eq!(h.state().doc.path, None, "nothing opened before the answer");
+    h.get_by_label("Discard changes").click();
+    h.step();
+    assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
+    assert!(!h.state().doc.is_dirty());
+}
+
+#[test]
+fn a_missing_obj_is_an_error_on_its_node_not_a_failure_to_open() {
+    let dir = temp_dir("missing-obj");
+    let path = dir.join("mesh.txt");
+    std::fs::write(
+        &path,
+        SPHERE_SCENE
+            .replace(
+                "Sphere { center 0 0 0 radius 1 }",
+                "TriangleMesh { obj_file nowhere.obj }",
+            )
+            .replace("OP", "UniformScale 1"),
+    )
+    .expect("write");
+    let mut h = harness(Some(path.clone()), (16, 16));
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(
+        app.doc.path.as_deref(),
+        Some(path.as_path()),
+        "the scene opened"
+    );
+    assert!(
+        app.doc.messages.iter().any(|m| m.contains("nowhere.obj")),
+        "{:?}",
+        app.doc.messages
+    );
+    let _ = h.get_by_label_contains("TriangleMesh: nowhere.obj (not loaded)");
+}
+
+#[test]
+fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
+    let mut h = harness(None, (16, 16));
+    settle(&mut h);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    for _ in 0..3 {
+        h.step();
+    }
+    assert!(h.state().dialog.is_some());
+    let target = repo("scenes/flat_transforms.txt");
+    h.get_by_role(egui::accesskit::Role::TextInput).focus();
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text(&target.display().to_string());
+    h.step();
+    h.get_by_label("Open").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    assert!(h.state().dialog.is_none());
+    assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
+}
+
+#[test]
+fn adding_a_triangle_mesh_and_loading_its_obj() {
+    let mut h = harness(Some(repo("scenes/flat_transforms.txt")), (16, 16));
+    settle(&mut h);
+    let before = h.state().doc.scene.graph.stats().triangles;
+    h.get_by_label("Add").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    h.get_by_label("TriangleMesh").click();
+    for _ in 0..2 {
+        h.step();
+    }
+    let Some(Selection::Node(id)) = h.state().doc.selection else {
+        panic!("the new mesh is selected")
+    };
+    h.get_by_role(egui::accesskit::Role::TextInput).focus();
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text("../assets/torus.obj");
+    h.step();
+    h.get_by_label("Load / reload").click();
+    h.step();
+    let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc.scene.graph.node(id).kind else {
+        panic!("a TriangleMesh")
+    };
+    assert_eq!(obj_file, "../assets/torus.obj");
+    assert!(mesh.mesh().is_some(), "loaded: {mesh:?}");
+    assert!(h.state().doc.scene.graph.stats().triangles > before);
+    // Adding and loading are two undo steps; both undo cleanly.
+    assert!(h.state_mut().doc.undo() && h.state_mut().doc.undo());
+    assert_eq!(h.state().doc.scene.graph.stats().triangles, before);
+}
