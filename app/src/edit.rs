@@ -60,6 +60,10 @@ pub enum Edit {
     WrapInGroup {
         node: NodeId,
     },
+    /// Swaps a CSG node's two operands (A − B becomes B − A).
+    SwapOperands {
+        node: NodeId,
+    },
     SetMaterial {
         index: usize,
         material: Material,
@@ -146,10 +150,22 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
         }
         Edit::SetNodeKind { node, kind } => {
             let n = g.get_mut(node).ok_or("no such node")?;
-            if n.kind.is_container() || kind.is_container() {
-                return Err("only a primitive's parameters can be replaced".into());
+            let csg_op_change = matches!((&n.kind, &kind), (NodeKind::Csg(_), NodeKind::Csg(_)));
+            if matches!(kind, NodeKind::Triangle { .. }) && parent_of(node).is_some_and(|p| matches!(g.node(p).kind, NodeKind::Csg(_))) {
+                return Err("a lone Triangle is not a solid, so it cannot be a CSG operand".into());
+            }
+            let n = g.get_mut(node).ok_or("no such node")?;
+            if !csg_op_change && (n.kind.is_container() || kind.is_container()) {
+                return Err("only a primitive's parameters (or a CSG node's operation) can be replaced".into());
             }
             n.kind = kind;
+        }
+        Edit::SwapOperands { node } => {
+            let n = g.get_mut(node).ok_or("no such node")?;
+            if !matches!(n.kind, NodeKind::Csg(_)) || n.children.len() != 2 {
+                return Err("only a CSG node's operands can be swapped".into());
+            }
+            n.children.swap(0, 1);
         }
         Edit::SetNodeMaterial { node, material } => {
             if node == g.root() {
@@ -161,22 +177,54 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
             if !reachable(parent) || !matches!(g.node(parent).kind, NodeKind::Group) {
                 return Err("new objects go into a Group".into());
             }
-            let id = if let NodeKind::Transform(_) = kind {
-                // A Transform always holds one object: give it a unit sphere to start with.
-                let child = g.add(Node::new(NodeKind::Sphere {
-                    center: Vec3::ZERO,
-                    radius: 1.0,
-                }));
-                let t = g.add(Node::new(kind));
-                g.push_child(t, child);
-                t
-            } else {
-                g.add(Node::new(kind))
+            let id = match kind {
+                NodeKind::Transform(_) => {
+                    // A Transform always holds one object: give it a unit sphere to start with.
+                    let child = g.add(Node::new(NodeKind::Sphere {
+                        center: Vec3::ZERO,
+                        radius: 1.0,
+                    }));
+                    let t = g.add(Node::new(kind));
+                    g.push_child(t, child);
+                    t
+                }
+                NodeKind::Csg(_) => {
+                    // A CSG node always holds two solids: a cube and a sphere poking out of
+                    // its faces show each operation clearly.
+                    let a = g.add(Node::new(NodeKind::Box {
+                        min: Vec3::splat(-1.0),
+                        max: Vec3::splat(1.0),
+                    }));
+                    let b = g.add(Node::new(NodeKind::Sphere {
+                        center: Vec3::ZERO,
+                        radius: 1.3,
+                    }));
+                    let c = g.add(Node::new(kind));
+                    g.push_child(c, a);
+                    g.push_child(c, b);
+                    c
+                }
+                kind => g.add(Node::new(kind)),
             };
             g.push_child(parent, id);
             return Ok(After::SelectNode(id));
         }
         Edit::DeleteNode { node } => {
+            // Deleting one operand of a CSG node leaves the other one in its place, which is
+            // what "A ∪ B without B" means.
+            if let Some(csg) = parent_of(node).filter(|&p| matches!(g.node(p).kind, NodeKind::Csg(_))) {
+                let other = *g.node(csg).children.iter().find(|&&c| c != node).ok_or("a CSG node needs two operands")?;
+                let slot_parent = parent_of(csg).ok_or("not in the scene")?;
+                let material = g.node(csg).material;
+                let o = g.node_mut(other);
+                o.material = o.material.or(material);
+                for c in &mut g.node_mut(slot_parent).children {
+                    if *c == csg {
+                        *c = other;
+                    }
+                }
+                return Ok(After::SelectNode(other));
+            }
             let slot = group_slot(node, root, &parent_of, g)?;
             let parent = parent_of(slot).ok_or("not in the scene")?;
             g.node_mut(parent).children.retain(|&c| c != slot);
@@ -229,6 +277,9 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 return Err("the root Group cannot be wrapped".into());
             }
             let parent = parent_of(node).ok_or("not in the scene")?;
+            if matches!(edit, Edit::WrapInGroup { .. }) && matches!(g.node(parent).kind, NodeKind::Csg(_)) {
+                return Err("a CSG operand must be a solid, and a Group is not one".into());
+            }
             let kind = match edit {
                 Edit::WrapInTransform { .. } => NodeKind::Transform(Vec::new()),
                 _ => NodeKind::Group,

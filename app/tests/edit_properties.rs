@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 use tracelab::edit::Edit;
 use tracelab::state::Document;
-use tracelab_core::{Background, Camera, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
+use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
 
 /// xorshift64*: small, seeded, repeatable.
 struct Rng(u64);
@@ -44,7 +44,12 @@ fn random_op(r: &mut Rng) -> TransformOp {
 }
 
 fn random_kind(r: &mut Rng) -> NodeKind {
-    match r.below(6) {
+    match r.below(9) {
+        6 => NodeKind::Box {
+            min: r.v() - Vec3::ONE,
+            max: r.v() + Vec3::ONE,
+        },
+        7 => NodeKind::Csg(CsgOp::ALL[r.below(3)]),
         0 => NodeKind::Sphere {
             center: r.v(),
             radius: r.f(),
@@ -74,7 +79,8 @@ fn random_node(r: &mut Rng, d: &Document) -> NodeId {
 fn random_edit(r: &mut Rng, d: &Document) -> Edit {
     let node = random_node(r, d);
     let small = r.below(4);
-    match r.below(20) {
+    match r.below(21) {
+        20 => Edit::SwapOperands { node },
         0 => Edit::SetTransformOp {
             node,
             index: small,
@@ -165,8 +171,11 @@ fn random_edits_and_undos_never_panic_and_full_undo_restores_the_document() {
                     }
                 }
             }
-            // Every state is a scene the renderer and the writer accept.
+            // Every state is a scene the renderer and the writer accept, and every CSG node
+            // still holds two solids.
             let _ = tracelab_core::write_scene(&d.scene);
+            let _ = tracelab_core::compile(&d.scene);
+            check_csg_operands(&d, seed);
         }
         assert!(
             applied > 20,
@@ -179,6 +188,76 @@ fn random_edits_and_undos_never_panic_and_full_undo_restores_the_document() {
             "seed {seed}: back at the opened state, nothing is unsaved"
         );
     }
+}
+
+fn check_csg_operands(d: &Document, seed: u64) {
+    let g = &d.scene.graph;
+    for id in g.preorder() {
+        let n = g.node(id);
+        if let NodeKind::Csg(op) = n.kind {
+            assert_eq!(n.children.len(), 2, "seed {seed}: {} with {} operands", op.name(), n.children.len());
+            for &c in &n.children {
+                let k = &g.node(c).kind;
+                assert!(
+                    !matches!(k, NodeKind::Group | NodeKind::Triangle { .. }),
+                    "seed {seed}: a {} became a CSG operand",
+                    k.name()
+                );
+            }
+        }
+    }
+}
+
+fn add_subtraction(d: &mut Document) -> NodeId {
+    let root = d.scene.graph.root();
+    d.apply(Edit::AddNode { parent: root, kind: NodeKind::Csg(CsgOp::Subtraction) }).expect("adds");
+    *d.scene.graph.node(root).children.last().expect("the new node")
+}
+
+#[test]
+fn a_new_csg_node_holds_two_solids_and_renders() {
+    let mut d = Document::builtin();
+    let csg = add_subtraction(&mut d);
+    let kids = d.scene.graph.node(csg).children.clone();
+    assert_eq!(kids.len(), 2);
+    assert!(matches!(d.scene.graph.node(kids[0]).kind, NodeKind::Box { .. }));
+    assert!(matches!(d.scene.graph.node(kids[1]).kind, NodeKind::Sphere { .. }));
+    let text = tracelab_core::write_scene(&d.scene);
+    assert!(text.contains("Subtraction {"), "{text}");
+    // Switching the operation and swapping operands are single edits that undo.
+    let before = d.scene.clone();
+    d.apply(Edit::SetNodeKind { node: csg, kind: NodeKind::Csg(CsgOp::Union) }).expect("op change");
+    d.apply(Edit::SwapOperands { node: csg }).expect("swap");
+    assert_eq!(d.scene.graph.node(csg).kind, NodeKind::Csg(CsgOp::Union));
+    assert_eq!(d.scene.graph.node(csg).children, [kids[1], kids[0]]);
+    while d.scene != before && d.undo() {}
+    assert_eq!(d.scene, before);
+}
+
+#[test]
+fn deleting_one_operand_leaves_the_other_in_the_csg_node_s_place() {
+    let mut d = Document::builtin();
+    let csg = add_subtraction(&mut d);
+    let [a, b] = d.scene.graph.node(csg).children[..] else { panic!("two operands") };
+    d.apply(Edit::DeleteNode { node: b }).expect("deletes");
+    let root = d.scene.graph.root();
+    let kids = &d.scene.graph.node(root).children;
+    assert_eq!(kids.last(), Some(&a), "the Box takes the Subtraction's place");
+    assert!(!kids.contains(&csg));
+}
+
+#[test]
+fn a_csg_operand_cannot_become_a_group_or_a_triangle() {
+    let mut d = Document::builtin();
+    let csg = add_subtraction(&mut d);
+    let a = d.scene.graph.node(csg).children[0];
+    let before = d.scene.clone();
+    assert!(d.apply(Edit::WrapInGroup { node: a }).is_err());
+    let tri = NodeKind::Triangle { vertices: [Vec3::ZERO, Vec3::X, Vec3::Y] };
+    assert!(d.apply(Edit::SetNodeKind { node: a, kind: tri }).is_err());
+    assert_eq!(d.scene, before);
+    // Wrapping in a Transform keeps it a solid, so that is allowed.
+    d.apply(Edit::WrapInTransform { node: a }).expect("a Transform of a solid is a solid");
 }
 
 #[test]

@@ -504,3 +504,44 @@ fn adding_a_triangle_mesh_and_loading_its_obj() {
     assert!(h.state_mut().doc.undo() && h.state_mut().doc.undo());
     assert_eq!(h.state().doc.scene.graph.stats().triangles, before);
 }
+
+#[test]
+fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
+    let mut h = harness(Some(repo("scenes/lecture/csg_subtraction.txt")), (32, 32));
+    settle(&mut h);
+    let csg = h
+        .state()
+        .doc
+        .scene
+        .graph
+        .iter()
+        .find(|(_, n)| matches!(n.kind, NodeKind::Csg(_)))
+        .map(|(id, _)| id)
+        .expect("the scene has a CSG node");
+    let before = h.state().doc.scene.graph.node(csg).children.clone();
+    h.get_by_label_contains("Subtraction: A minus B").click();
+    h.step();
+    assert_eq!(h.state().doc.selection, Some(Selection::Node(csg)));
+    let generation = h.state().doc.generation;
+    h.get_by_label("Union").click();
+    h.step();
+    assert_eq!(h.state().doc.scene.graph.node(csg).kind, NodeKind::Csg(tracelab_core::CsgOp::Union));
+    assert!(h.state().doc.generation > generation, "the edit restarts the render");
+    h.get_by_label("Swap A and B").click();
+    h.step();
+    let after = h.state().doc.scene.graph.node(csg).children.clone();
+    assert_eq!(after, [before[1], before[0]]);
+    settle(&mut h);
+    // Clicking the render on a CSG surface selects the operand it came from.
+    let pixel = h.state().worker.with_published(|p| {
+        let p = p.expect("rendered");
+        let f = p.frames[0].lock();
+        let s = f.get(16, 16).expect("in frame");
+        s.is_hit().then_some(NodeId(s.node))
+    });
+    let node = pixel.expect("the centre pixel shows the union");
+    assert!(
+        matches!(h.state().doc.scene.graph.node(node).kind, NodeKind::Sphere { .. }),
+        "an operand, not the CSG node"
+    );
+}

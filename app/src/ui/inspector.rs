@@ -3,7 +3,7 @@
 
 use egui::DragValue;
 use glam::{Mat4, Vec3};
-use tracelab_core::{Background, Camera, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
+use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
 
 use crate::edit::Edit;
 use crate::state::{Document, Selection};
@@ -354,9 +354,42 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
                 });
             }
         }
-        #[allow(unreachable_patterns)]
-        _ => {
-            ui.label("This node has no editable parameters here yet.");
+        NodeKind::Box { min, max } => {
+            let mut c = vec3(ui, "min", min, 0.02);
+            c |= vec3(ui, "max", max, 0.02);
+            if c {
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: kind.clone(),
+                });
+            }
+        }
+        NodeKind::Csg(op) => {
+            let mut chosen = *op;
+            ui.horizontal(|ui| {
+                ui.label("operation");
+                for o in CsgOp::ALL {
+                    ui.selectable_value(&mut chosen, o, o.name());
+                }
+            });
+            if chosen != *op {
+                edits.push(Edit::SetNodeKind {
+                    node: id,
+                    kind: NodeKind::Csg(chosen),
+                });
+            }
+            let g = &doc.scene.graph;
+            for (name, c) in ["A", "B"].iter().zip(&n.children) {
+                let label = g.get(*c).map_or("?", |k| k.kind.name());
+                ui.label(format!("{name}: {label}"));
+            }
+            if ui
+                .button("Swap A and B")
+                .on_hover_text("A minus B becomes B minus A")
+                .clicked()
+            {
+                edits.push(Edit::SwapOperands { node: id });
+            }
         }
     }
 }

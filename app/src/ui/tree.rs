@@ -2,7 +2,7 @@
 //! a UI), then drawn; clicks and toolbar buttons become selections and [`Edit`]s.
 
 use glam::Vec3;
-use tracelab_core::{MeshSlot, NodeId, NodeKind, Scene, TransformOp};
+use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 
 use crate::edit::Edit;
 use crate::state::{Document, Selection};
@@ -42,8 +42,16 @@ pub fn node_label(kind: &NodeKind, children: usize) -> String {
             }
             MeshSlot::Failed(_) => format!("TriangleMesh: {obj_file} (not loaded)"),
         },
-        #[allow(unreachable_patterns)]
-        other => other.name().to_string(),
+        NodeKind::Box { min, max } => format!("Box: ({}) to ({})", v(*min), v(*max)),
+        NodeKind::Csg(op) => {
+            // Words, not ∪ ∩ −: egui's default fonts have no glyphs for them.
+            let what = match op {
+                CsgOp::Union => "A or B",
+                CsgOp::Intersection => "A and B",
+                CsgOp::Subtraction => "A minus B",
+            };
+            format!("{}: {what}", op.name())
+        }
     }
 }
 
@@ -202,7 +210,7 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
     };
     ui.horizontal_wrapped(|ui| {
         ui.menu_button("Add", |ui| {
-            let kinds: [(&str, NodeKind); 6] = [
+            let kinds: [(&str, NodeKind); 10] = [
                 (
                     "Sphere",
                     NodeKind::Sphere {
@@ -234,6 +242,16 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
                         mesh: MeshSlot::Failed("no OBJ file chosen yet".into()),
                     },
                 ),
+                (
+                    "Box",
+                    NodeKind::Box {
+                        min: Vec3::splat(-1.0),
+                        max: Vec3::splat(1.0),
+                    },
+                ),
+                ("Union of a box and a sphere", NodeKind::Csg(CsgOp::Union)),
+                ("Intersection of a box and a sphere", NodeKind::Csg(CsgOp::Intersection)),
+                ("Box minus a sphere (Subtraction)", NodeKind::Csg(CsgOp::Subtraction)),
                 ("Group", NodeKind::Group),
                 (
                     "Transform",

@@ -892,7 +892,7 @@ impl<'a> Parser<'a> {
         graph: &mut Graph,
     ) -> Option<Frame> {
         let open = self.expect_open(w)?;
-        let mut attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind| {
+        let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind| {
             let id = graph.add(Node { kind, material, children: Vec::new() });
             graph.push_child(parent, id);
             this.record_offset(id, off);

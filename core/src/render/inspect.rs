@@ -78,8 +78,8 @@ pub fn inspect_pixel(
     let hit = compiled
         .intersect(&world_ray, compiled.camera.t_min(), f32::INFINITY)
         .and_then(|hit| {
-            let object = compiled.objects.get(hit.object as usize)?;
-            let node = object.node;
+            // For a CSG hit, the operand whose surface it is (its path holds the CSG node).
+            let node = compiled.hit_node(&hit)?;
             let ids = scene.graph.path_to(node)?;
             let mut m = Mat4::IDENTITY;
             let mut path = Vec::with_capacity(ids.len());
@@ -215,5 +215,42 @@ Group { numObjects 1
         let story = inspect_pixel(&s, &c, &RenderSettings::new(40, 40), 26, 16);
         let h = story.hit.expect("hits");
         assert!(h.normal_angle_degrees < 0.05, "{}", h.normal_angle_degrees);
+    }
+
+    #[test]
+    fn a_csg_pixel_names_the_operand_and_matches_the_render() {
+        // A red box minus a squashed blue sphere: the pit's floor is the sphere's surface,
+        // flipped, and must be reported as the sphere (inside its Transform), in blue.
+        let text = "
+OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }
+Lights { numLights 1 DirectionalLight { direction -0.2 -0.3 -1 color 0.8 0.8 0.8 } }
+Background { color 0 0 0 ambientLight 0.2 0.2 0.2 }
+Materials { numMaterials 2 Material { diffuseColor 1 0 0 } Material { diffuseColor 0 0 1 } }
+Group { numObjects 1
+  Subtraction {
+    MaterialIndex 0
+    Box { min -1 -1 -1 max 1 1 1 }
+    MaterialIndex 1
+    Transform { Scale 1 1 0.5 Translate 0 0 2 Sphere { center 0 0 0 radius 1.2 } } } }
+";
+        let s = scene(text);
+        let c = CompiledScene::new(&s);
+        let settings = RenderSettings::new(40, 40);
+        let frame = render_frame(&c, &settings);
+        let story = inspect_pixel(&s, &c, &settings, 22, 18);
+        let h = story.hit.as_ref().expect("the pit is hit");
+        let kinds: Vec<_> = h.path.iter().map(|p| p.kind).collect();
+        assert_eq!(kinds, ["Group", "Subtraction", "Transform", "Sphere"]);
+        assert_eq!(frame.get(22, 18).expect("in frame").node, h.node.0);
+        assert_eq!(h.shade.diffuse, Vec3::new(0.0, 0.0, 1.0));
+        // The exposed inner surface faces the viewer.
+        assert!(h.normal_correct.z > 0.0, "{:?}", h.normal_correct);
+        let px = frame.get(22, 18).expect("in frame");
+        let e = story.color();
+        assert_eq!(px.color, [quantize(e.x), quantize(e.y), quantize(e.z)]);
+        // In a corner of the front face, beyond the pit, the surface is the Box itself.
+        let edge = inspect_pixel(&s, &c, &settings, 10, 10);
+        let eh = edge.hit.expect("box face");
+        assert_eq!(eh.path.last().map(|p| p.kind), Some("Box"));
     }
 }
