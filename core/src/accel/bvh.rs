@@ -39,8 +39,17 @@ pub struct Bvh {
 }
 
 enum Tmp {
-    Leaf { bounds: Aabb, first: usize, count: usize },
-    Inner { bounds: Aabb, left: Box<Tmp>, right: Box<Tmp>, size: usize },
+    Leaf {
+        bounds: Aabb,
+        first: usize,
+        count: usize,
+    },
+    Inner {
+        bounds: Aabb,
+        left: Box<Tmp>,
+        right: Box<Tmp>,
+        size: usize,
+    },
 }
 
 impl Tmp {
@@ -68,7 +77,11 @@ impl Bvh {
         let mut prims: Vec<Prim> = bounds
             .par_iter()
             .enumerate()
-            .map(|(i, b)| Prim { bounds: *b, centroid: b.center(), id: i as u32 })
+            .map(|(i, b)| Prim {
+                bounds: *b,
+                centroid: b.center(),
+                id: i as u32,
+            })
             .collect();
         let root = build_rec(&mut prims, 0);
         let mut nodes = Vec::with_capacity(root.size());
@@ -78,7 +91,10 @@ impl Bvh {
     }
 
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map(|n| n.bounds()).unwrap_or(Aabb::EMPTY)
+        self.nodes
+            .first()
+            .map(|n| n.bounds())
+            .unwrap_or(Aabb::EMPTY)
     }
 
     /// Closest-hit traversal, near child first. `leaf(prim_id, t_max)` returns a closer t if
@@ -99,7 +115,11 @@ impl Bvh {
         let mut stack = [0u32; 64];
         let mut sp = 0usize;
         let mut idx = 0u32;
-        if self.nodes[0].bounds().hit(origin, inv, t_min, t_max).is_none() {
+        if self.nodes[0]
+            .bounds()
+            .hit(origin, inv, t_min, t_max)
+            .is_none()
+        {
             return t_max;
         }
         loop {
@@ -114,8 +134,12 @@ impl Bvh {
             } else {
                 let l = idx + 1;
                 let r = node.right_or_first;
-                let tl = self.nodes[l as usize].bounds().hit(origin, inv, t_min, t_max);
-                let tr = self.nodes[r as usize].bounds().hit(origin, inv, t_min, t_max);
+                let tl = self.nodes[l as usize]
+                    .bounds()
+                    .hit(origin, inv, t_min, t_max);
+                let tr = self.nodes[r as usize]
+                    .bounds()
+                    .hit(origin, inv, t_min, t_max);
                 match (tl, tr) {
                     (Some(a), Some(b)) => {
                         let (near, far) = if a <= b { (l, r) } else { (r, l) };
@@ -144,7 +168,11 @@ impl Bvh {
                 }
                 sp -= 1;
                 let n = stack[sp];
-                if self.nodes[n as usize].bounds().hit(origin, inv, t_min, t_max).is_some() {
+                if self.nodes[n as usize]
+                    .bounds()
+                    .hit(origin, inv, t_min, t_max)
+                    .is_some()
+                {
                     idx = n;
                     break;
                 }
@@ -156,7 +184,11 @@ impl Bvh {
     /// their parents' bounds, leaves holding the boxes of their primitives. For tests.
     pub fn check_invariants(&self, bounds: &[Aabb]) -> Result<(), String> {
         if bounds.is_empty() {
-            return if self.nodes.is_empty() { Ok(()) } else { Err("nodes for no primitives".into()) };
+            return if self.nodes.is_empty() {
+                Ok(())
+            } else {
+                Err("nodes for no primitives".into())
+            };
         }
         let mut seen = vec![0u32; bounds.len()];
         let mut stack = vec![0usize];
@@ -170,7 +202,9 @@ impl Bvh {
                     .get(first..first + n.count as usize)
                     .ok_or(format!("leaf {i} range out of bounds"))?;
                 for &p in ids {
-                    let b = bounds.get(p as usize).ok_or(format!("bad primitive id {p}"))?;
+                    let b = bounds
+                        .get(p as usize)
+                        .ok_or(format!("bad primitive id {p}"))?;
                     if !nb.contains(b) {
                         return Err(format!("leaf {i} does not contain primitive {p}"));
                     }
@@ -196,13 +230,23 @@ impl Bvh {
 fn build_rec(prims: &mut [Prim], first: usize) -> Tmp {
     let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
     let n = prims.len();
-    let leaf = Tmp::Leaf { bounds, first, count: n };
+    let leaf = Tmp::Leaf {
+        bounds,
+        first,
+        count: n,
+    };
     if n <= MAX_LEAF {
         return leaf;
     }
     let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
     let ext = cb.extent();
-    let axis = if ext.x >= ext.y && ext.x >= ext.z { 0 } else if ext.y >= ext.z { 1 } else { 2 };
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
     let lo = cb.min[axis];
     let span = ext[axis];
     let mid = if span > 0.0 && span.is_finite() {
@@ -229,7 +273,8 @@ fn build_rec(prims: &mut [Prim], first: usize) -> Tmp {
         for i in 0..BINS - 1 {
             acc = acc.union(bins[i].0);
             cnt += bins[i].1;
-            let cost = acc.surface_area() * cnt as f32 + right_area[i + 1] * right_count[i + 1] as f32;
+            let cost =
+                acc.surface_area() * cnt as f32 + right_area[i + 1] * right_count[i + 1] as f32;
             if cost < best.0 {
                 best = (cost, i);
             }
@@ -252,7 +297,12 @@ fn build_rec(prims: &mut [Prim], first: usize) -> Tmp {
         (build_rec(l, first), build_rec(r, first + mid))
     };
     let size = 1 + left.size() + right.size();
-    Tmp::Inner { bounds, left: Box::new(left), right: Box::new(right), size }
+    Tmp::Inner {
+        bounds,
+        left: Box::new(left),
+        right: Box::new(right),
+        size,
+    }
 }
 
 fn partition(prims: &mut [Prim], pred: impl Fn(&Prim) -> bool) -> usize {
@@ -275,14 +325,28 @@ fn flatten(root: Tmp, out: &mut Vec<BvhNode>) {
             out[p].right_or_first = me as u32;
         }
         match node {
-            Tmp::Leaf { bounds, first, count } => out.push(BvhNode {
+            Tmp::Leaf {
+                bounds,
+                first,
+                count,
+            } => out.push(BvhNode {
                 min: bounds.min.into(),
                 right_or_first: first as u32,
                 max: bounds.max.into(),
                 count: count as u32,
             }),
-            Tmp::Inner { bounds, left, right, .. } => {
-                out.push(BvhNode { min: bounds.min.into(), right_or_first: 0, max: bounds.max.into(), count: 0 });
+            Tmp::Inner {
+                bounds,
+                left,
+                right,
+                ..
+            } => {
+                out.push(BvhNode {
+                    min: bounds.min.into(),
+                    right_or_first: 0,
+                    max: bounds.max.into(),
+                    count: 0,
+                });
                 // Right is flattened after the whole left subtree and patches our pointer.
                 stack.push((*right, Some(me)));
                 stack.push((*left, None));
@@ -317,7 +381,8 @@ mod tests {
         for n in [0, 1, 2, 5, 17, 1000, 10_000] {
             let b = boxes(n);
             let bvh = Bvh::build(&b);
-            bvh.check_invariants(&b).unwrap_or_else(|e| panic!("n={n}: {e}"));
+            bvh.check_invariants(&b)
+                .unwrap_or_else(|e| panic!("n={n}: {e}"));
         }
     }
 
