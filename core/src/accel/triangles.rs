@@ -337,6 +337,14 @@ impl TriangleBvh {
                         cur = n.child[i];
                         continue;
                     }
+                    if rest & (rest - 1) == 0 {
+                        // Two children, the common case below the top: no sort needed.
+                        let j = rest.trailing_zeros() as usize;
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push(n.child[far], tn[far]);
+                        cur = n.child[near];
+                        continue;
+                    }
                     // Several children: push them all, nearest on top, and take the nearest.
                     let mut m = mask;
                     let mut k = 0;
