@@ -116,6 +116,85 @@ impl RayPre {
     }
 }
 
+/// The closest-hit traversal, expanded once per slab test so each copy is compiled for the
+/// instruction set its function enables.
+macro_rules! closest_hit {
+    ($self:ident, $ray:expr, $t_min:expr, $t_max:expr, $slab:expr) => {{
+        let (ray, t_min, t_max) = ($ray, $t_min, $t_max);
+        if $self.nodes.is_empty() {
+            return None;
+        }
+        let r = RayPre::new(ray);
+        let mut t_best = t_max;
+        let mut best = usize::MAX;
+        let mut stack = RayStack::new();
+        let mut tn = [0.0f32; WIDTH];
+        let mut cur: Child = 0;
+        loop {
+            if wide::is_leaf(cur) {
+                let (first, count) = wide::leaf_range(cur);
+                for k in first..first + count {
+                    if let Some(t) = $self.tris[k].hit(r.o, r.d) {
+                        if t > t_min && t < t_best {
+                            t_best = t;
+                            best = k;
+                        }
+                    }
+                }
+            } else {
+                let n = &$self.nodes[cur as usize];
+                let mask = $slab(&r, n, t_min, t_best, &mut tn);
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = n.child[i];
+                        continue;
+                    }
+                    if rest & (rest - 1) == 0 {
+                        // Two children, the common case below the top: no sort needed.
+                        let j = rest.trailing_zeros() as usize;
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push(n.child[far], tn[far]);
+                        cur = n.child[near];
+                        continue;
+                    }
+                    // Several children: push them all, nearest on top, and take the nearest.
+                    let mut m = mask;
+                    let mut k = 0;
+                    while m != 0 {
+                        let j = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        stack.push(n.child[j], tn[j]);
+                        k += 1;
+                    }
+                    stack.sort_top(k);
+                    if let Some((c, _)) = stack.pop() {
+                        cur = c;
+                        continue;
+                    }
+                }
+            }
+            // Pop the nearest child not ruled out by a closer hit found since it was pushed.
+            loop {
+                match stack.pop() {
+                    None => {
+                        return (best != usize::MAX).then(|| TriangleHit {
+                            t: t_best,
+                            triangle: $self.ids[best],
+                        });
+                    }
+                    Some((c, t)) if t <= t_best => {
+                        cur = c;
+                        break;
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+    }};
+}
+
 impl TriangleBvh {
     /// Builds over the mesh. Vertex indices out of range read as the origin (the loaders
     /// reject them); triangles beyond 2^28 are left out.
@@ -302,83 +381,71 @@ impl TriangleBvh {
     /// Closest hit in (t_min, t_max). Two-sided Möller–Trumbore.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
-        self.intersect_any_cpu(ray, t_min, t_max)
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above (std caches the answer).
+            return unsafe { self.intersect_avx(ray, t_min, t_max) };
+        }
+        closest_hit!(self, ray, t_min, t_max, RayPre::slab8)
     }
 
-    #[inline(always)]
-    fn intersect_any_cpu(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
-        if self.nodes.is_empty() {
-            return None;
-        }
-        let r = RayPre::new(ray);
-        let mut t_best = t_max;
-        let mut best = usize::MAX;
-        let mut stack = RayStack::new();
-        let mut tn = [0.0f32; WIDTH];
-        let mut cur: Child = 0;
-        loop {
-            if wide::is_leaf(cur) {
-                let (first, count) = wide::leaf_range(cur);
-                for k in first..first + count {
-                    if let Some(t) = self.tris[k].hit(r.o, r.d) {
-                        if t > t_min && t < t_best {
-                            t_best = t;
-                            best = k;
-                        }
-                    }
-                }
-            } else {
-                let n = &self.nodes[cur as usize];
-                let mask = r.slab8(n, t_min, t_best, &mut tn);
-                if mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    let rest = mask & (mask - 1);
-                    if rest == 0 {
-                        cur = n.child[i];
-                        continue;
-                    }
-                    if rest & (rest - 1) == 0 {
-                        // Two children, the common case below the top: no sort needed.
-                        let j = rest.trailing_zeros() as usize;
-                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
-                        stack.push(n.child[far], tn[far]);
-                        cur = n.child[near];
-                        continue;
-                    }
-                    // Several children: push them all, nearest on top, and take the nearest.
-                    let mut m = mask;
-                    let mut k = 0;
-                    while m != 0 {
-                        let j = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        stack.push(n.child[j], tn[j]);
-                        k += 1;
-                    }
-                    stack.sort_top(k);
-                    if let Some((c, _)) = stack.pop() {
-                        cur = c;
-                        continue;
-                    }
-                }
-            }
-            // Pop the nearest child not ruled out by a closer hit found since it was pushed.
-            loop {
-                match stack.pop() {
-                    None => {
-                        return (best != usize::MAX).then(|| TriangleHit {
-                            t: t_best,
-                            triangle: self.ids[best],
-                        });
-                    }
-                    Some((c, t)) if t <= t_best => {
-                        cur = c;
-                        break;
-                    }
-                    Some(_) => {}
-                }
-            }
-        }
+    /// The 8 slots in one 256-bit register. Measured (best of 20 frames, 800x800, 1 thread):
+    /// bunny69k 8.77 -> 8.93 Mrays/s, dragon 7.55 -> 7.88, bunny_1k unchanged.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn intersect_avx(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        closest_hit!(self, ray, t_min, t_max, slab8_avx)
     }
+}
+
+/// `RayPre::slab8` with AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+fn slab8_avx(r: &RayPre, n: &Node8, t_min: f32, t_max: f32, tn: &mut [f32; WIDTH]) -> u32 {
+    use std::arch::x86_64::*;
+    #[allow(unsafe_code)]
+    // SAFETY: an axis row [Vec4; 2] is 8 contiguous f32 (Vec4 is a 16-byte __m128);
+    // unaligned loads ask nothing more.
+    let ld = |v: &[Vec4; 2]| unsafe { _mm256_loadu_ps(v.as_ptr().cast::<f32>()) };
+    let pick = |a: usize| {
+        if r.neg[a] {
+            (&n.hi[a], &n.lo[a])
+        } else {
+            (&n.lo[a], &n.hi[a])
+        }
+    };
+    let (nx, fx) = pick(0);
+    let (ny, fy) = pick(1);
+    let (nz, fz) = pick(2);
+    let (ox, oy, oz) = (
+        _mm256_set1_ps(r.o.x),
+        _mm256_set1_ps(r.o.y),
+        _mm256_set1_ps(r.o.z),
+    );
+    let (ix, iy, iz) = (
+        _mm256_set1_ps(r.inv.x),
+        _mm256_set1_ps(r.inv.y),
+        _mm256_set1_ps(r.inv.z),
+    );
+    let slab = |p: &[Vec4; 2], o: __m256, i: __m256| _mm256_mul_ps(_mm256_sub_ps(ld(p), o), i);
+    // Operand order as in the SSE version: NaN in the first operand yields the second.
+    let near = _mm256_max_ps(
+        _mm256_max_ps(slab(nx, ox, ix), slab(ny, oy, iy)),
+        _mm256_max_ps(slab(nz, oz, iz), _mm256_set1_ps(t_min)),
+    );
+    let far = _mm256_min_ps(
+        _mm256_min_ps(slab(fx, ox, ix), slab(fy, oy, iy)),
+        _mm256_min_ps(slab(fz, oz, iz), _mm256_set1_ps(t_max)),
+    );
+    let far = _mm256_mul_ps(far, _mm256_set1_ps(1.000_000_4));
+    #[allow(unsafe_code)]
+    // SAFETY: `tn` is 8 f32, exactly one unaligned 256-bit store.
+    unsafe {
+        _mm256_storeu_ps(tn.as_mut_ptr(), near)
+    };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
 }
 
 #[cfg(test)]

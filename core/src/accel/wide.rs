@@ -128,8 +128,9 @@ pub const STACK: usize = WIDTH * (MAX_DEPTH + 1);
 
 /// A fixed, uninitialised stack of (child, entry distance) for one traversal.
 ///
-/// Uninitialised because zeroing 4 KiB per ray cost ~8% of bunny_1k throughput (measured:
-/// 14.1 vs 15.3 Mrays/s, 1 thread, 800x800, tracelab bench).
+/// Uninitialised because zeroing its 4 KiB on every ray cost a fifth of the throughput
+/// (measured, best of 20 frames, 800x800, 1 thread: bunny_1k 13.2 vs 16.6 Mrays/s, Stanford
+/// bunny 7.1 vs 8.9).
 pub struct RayStack {
     items: [MaybeUninit<(Child, f32)>; STACK],
     len: usize,
