@@ -387,6 +387,12 @@ impl TriangleBvh {
             // SAFETY: the CPU has AVX, checked just above (std caches the answer).
             return unsafe { self.intersect_avx(ray, t_min, t_max) };
         }
+        self.intersect_portable(ray, t_min, t_max)
+    }
+
+    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
+    #[inline(always)]
+    fn intersect_portable(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         closest_hit!(self, ray, t_min, t_max, RayPre::slab8)
     }
 
@@ -514,6 +520,8 @@ mod tests {
     fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray]) {
         for (k, ray) in rays.iter().enumerate() {
             let a = bvh.intersect(ray, 0.0, f32::INFINITY);
+            // Whichever instruction set `intersect` picked, the portable path must agree.
+            assert_eq!(a, bvh.intersect_portable(ray, 0.0, f32::INFINITY), "ray {k}");
             let b = brute(pos, tris, ray, 0.0);
             match (a, b) {
                 (None, None) => {}
