@@ -1,7 +1,7 @@
 //! A binary BVH built with binned SAH, flattened depth-first into 32-byte nodes. It knows
 //! only boxes; callers intersect their primitives in a leaf closure.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
 use crate::geometry::Aabb;
@@ -23,6 +23,16 @@ pub struct BvhNode {
 }
 
 impl BvhNode {
+    /// Slab test: the entry distance if the ray meets the box within [t_min, t_max].
+    #[inline(always)]
+    fn hit(&self, o: Vec3A, inv: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
+        let t0 = (Vec3A::from(self.min) - o) * inv;
+        let t1 = (Vec3A::from(self.max) - o) * inv;
+        let near = t0.min(t1).max_element().max(t_min);
+        let far = t0.max(t1).min_element().min(t_max);
+        (near <= far).then_some(near)
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb::new(Vec3::from(self.min), Vec3::from(self.max))
     }
@@ -111,13 +121,13 @@ impl Bvh {
         if self.nodes.is_empty() {
             return t_max;
         }
-        let inv = dir.recip();
+        // Packed (Vec3A) arithmetic: every ray pays for this on its critical path.
+        let (o, inv) = (Vec3A::from(origin), Vec3A::from(dir).recip());
         let mut stack = [0u32; 64];
         let mut sp = 0usize;
         let mut idx = 0u32;
         if self.nodes[0]
-            .bounds()
-            .hit(origin, inv, t_min, t_max)
+            .hit(o, inv, t_min, t_max)
             .is_none()
         {
             return t_max;
@@ -135,11 +145,9 @@ impl Bvh {
                 let l = idx + 1;
                 let r = node.right_or_first;
                 let tl = self.nodes[l as usize]
-                    .bounds()
-                    .hit(origin, inv, t_min, t_max);
+                    .hit(o, inv, t_min, t_max);
                 let tr = self.nodes[r as usize]
-                    .bounds()
-                    .hit(origin, inv, t_min, t_max);
+                    .hit(o, inv, t_min, t_max);
                 match (tl, tr) {
                     (Some(a), Some(b)) => {
                         let (near, far) = if a <= b { (l, r) } else { (r, l) };
@@ -169,8 +177,7 @@ impl Bvh {
                 sp -= 1;
                 let n = stack[sp];
                 if self.nodes[n as usize]
-                    .bounds()
-                    .hit(origin, inv, t_min, t_max)
+                    .hit(o, inv, t_min, t_max)
                     .is_some()
                 {
                     idx = n;

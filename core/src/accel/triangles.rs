@@ -67,7 +67,8 @@ struct RayPre {
 impl RayPre {
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
-        let inv = ray.direction.recip();
+        // One packed division rather than three scalar ones on every ray's critical path.
+        let inv = Vec3::from(glam::Vec3A::from(ray.direction).recip());
         RayPre {
             o: ray.origin,
             d: ray.direction,
