@@ -134,11 +134,12 @@ macro_rules! closest_hit {
         loop {
             if wide::is_leaf(cur) {
                 let (first, count) = wide::leaf_range(cur);
-                for k in first..first + count {
-                    if let Some(t) = $self.tris[k].hit(r.o, r.d) {
+                // One bounds check per leaf, not per triangle.
+                for (k, tri) in $self.tris.get(first..first + count).unwrap_or(&[]).iter().enumerate() {
+                    if let Some(t) = tri.hit(r.o, r.d) {
                         if t > t_min && t < t_best {
                             t_best = t;
-                            best = k;
+                            best = first + k;
                         }
                     }
                 }
