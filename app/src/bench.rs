@@ -100,10 +100,9 @@ fn distinct_meshes(scene: &Scene) -> Vec<Arc<Mesh>> {
             mesh: MeshSlot::Loaded(m),
             ..
         } = &n.kind
+            && !meshes.iter().any(|x| Arc::ptr_eq(x, m))
         {
-            if !meshes.iter().any(|x| Arc::ptr_eq(x, m)) {
-                meshes.push(m.clone());
-            }
+            meshes.push(m.clone());
         }
     }
     meshes

@@ -173,7 +173,9 @@ fn build_rec(prims: &mut [PrimRef], first: usize, bounds: Aabb, cb: Aabb, depth:
     // Levels a middle split still needs to reach leaves of MAX_LEAF.
     let levels_needed = (n.div_ceil(MAX_LEAF)).next_power_of_two().trailing_zeros() as usize;
     let ext = cb.extent();
-    let mid = if depth + levels_needed + 1 >= MAX_DEPTH || !(ext.max_element() > 0.0) {
+    // No positive extent (all centroids equal, or NaN): SAH has nothing to split on.
+    let flat = ext.max_element().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater);
+    let mid = if depth + levels_needed + 1 >= MAX_DEPTH || flat {
         if n <= MAX_LEAF {
             return leaf;
         }
@@ -238,7 +240,7 @@ fn children(prims: &mut [PrimRef], first: usize, bounds: Aabb, mid: usize, depth
 fn best_split(bins: &Bins, nb: usize, ext: &Vec3) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for a in 0..3 {
-        if !(ext[a] > 0.0) {
+        if ext[a].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let mut right_cost = [0.0f32; BINS];

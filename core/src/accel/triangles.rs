@@ -135,7 +135,13 @@ macro_rules! closest_hit {
             if wide::is_leaf(cur) {
                 let (first, count) = wide::leaf_range(cur);
                 // One bounds check per leaf, not per triangle.
-                for (k, tri) in $self.tris.get(first..first + count).unwrap_or(&[]).iter().enumerate() {
+                for (k, tri) in $self
+                    .tris
+                    .get(first..first + count)
+                    .unwrap_or(&[])
+                    .iter()
+                    .enumerate()
+                {
                     if let Some(t) = tri.hit(r.o, r.d) {
                         if t > t_min && t < t_best {
                             t_best = t;
@@ -298,10 +304,10 @@ impl TriangleBvh {
                 }
                 used += 1;
                 let b = n.slot_bounds(s);
-                if let Some(pb) = parent_box {
-                    if !pb.contains(&b) {
-                        return Err(format!("node {i} slot {s} escapes its parent's box"));
-                    }
+                if let Some(pb) = parent_box
+                    && !pb.contains(&b)
+                {
+                    return Err(format!("node {i} slot {s} escapes its parent's box"));
                 }
                 let c = n.child[s];
                 if wide::is_leaf(c) {
@@ -359,13 +365,14 @@ impl TriangleBvh {
             if wide::is_leaf(c) {
                 let (first, count) = wide::leaf_range(c);
                 for k in first..first + count {
-                    if let Some(t) = self.tris[k].hit(r.o, r.d) {
-                        if t > t_min && t < t_max {
-                            out.push(TriangleHit {
-                                t,
-                                triangle: self.ids[k],
-                            });
-                        }
+                    if let Some(t) = self.tris[k].hit(r.o, r.d)
+                        && t > t_min
+                        && t < t_max
+                    {
+                        out.push(TriangleHit {
+                            t,
+                            triangle: self.ids[k],
+                        });
                     }
                 }
                 continue;
@@ -523,7 +530,11 @@ mod tests {
         for (k, ray) in rays.iter().enumerate() {
             let a = bvh.intersect(ray, 0.0, f32::INFINITY);
             // Whichever instruction set `intersect` picked, the portable path must agree.
-            assert_eq!(a, bvh.intersect_portable(ray, 0.0, f32::INFINITY), "ray {k}");
+            assert_eq!(
+                a,
+                bvh.intersect_portable(ray, 0.0, f32::INFINITY),
+                "ray {k}"
+            );
             let b = brute(pos, tris, ray, 0.0);
             match (a, b) {
                 (None, None) => {}
