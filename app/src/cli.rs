@@ -45,6 +45,8 @@ pub enum Command {
     },
     /// Time closest-hit queries for one primary ray per pixel (see ../shared/perf).
     Bench(BenchArgs),
+    /// Time the progressive renderer from a scene change to the first coarse and the full image.
+    BenchProgressive(ProgressiveArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -79,6 +81,18 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
     #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ProgressiveArgs {
+    pub scene: PathBuf,
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800])]
+    pub size: Vec<u32>,
+    /// Threads (default: all cores, as the GUI uses).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[arg(long, default_value_t = 10)]
     pub repeat: usize,
 }
 
@@ -166,7 +180,10 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
     match cli.command {
         Some(Command::Render(r)) => run_render(&render_job(r)?),
         Some(Command::Fmt { scene, output }) => run_fmt(&scene, output.as_deref()),
-        Some(Command::Bench(b)) => run_bench(&b),
+        Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
+        Some(Command::BenchProgressive(b)) => {
+            with_threads(b.threads.unwrap_or_else(rayon::current_num_threads), || crate::bench::run_progressive(&b))
+        }
         None => run_gui(cli.scene),
     }
 }
@@ -381,10 +398,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     })
 }
 
-fn run_bench(b: &BenchArgs) -> Result<(), CliError> {
+fn with_threads(threads: usize, f: impl FnOnce() -> Result<(), CliError> + Send) -> Result<(), CliError> {
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(b.threads.max(1))
+        .num_threads(threads.max(1))
         .build()
         .map_err(|e| CliError::Failed(format!("cannot start threads: {e}")))?;
-    pool.install(|| crate::bench::run(b))
+    pool.install(f)
 }

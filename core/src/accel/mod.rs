@@ -1,7 +1,10 @@
-//! Acceleration structures: a binned-SAH BVH over boxes, and a triangle BVH for meshes.
+//! Acceleration structures: a binned-SAH BVH over boxes (the scene's objects), and an 8-wide
+//! BVH over a mesh's triangles.
 
 mod bvh;
+mod sah;
 mod triangles;
+mod wide;
 
 pub use bvh::{Bvh, BvhNode};
 pub use triangles::{TriangleBvh, TriangleHit};

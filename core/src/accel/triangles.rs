@@ -1,10 +1,12 @@
-//! A BVH over a mesh's triangles, with the triangles stored in leaf order as (v0, e1, e2)
-//! so a leaf test touches contiguous memory and skips two subtractions per triangle.
+//! A BVH over a mesh's triangles: binned SAH on three axes, built in parallel, collapsed into
+//! 8-wide nodes, with the triangles stored in leaf order as (v0, e1, e2) so a leaf test reads
+//! contiguous memory and skips two subtractions per triangle.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::Bvh;
+use super::sah::{self, PrimRef};
+use super::wide::{self, Child, Node8, RayStack, WIDTH};
 use crate::geometry::{Aabb, Ray};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,7 +18,7 @@ struct Tri {
 
 impl Tri {
     /// Two-sided Möller–Trumbore: the ray parameter of a hit, if any.
-    #[inline]
+    #[inline(always)]
     fn hit(&self, o: Vec3, d: Vec3) -> Option<f32> {
         let p = d.cross(self.e2);
         let det = self.e1.dot(p);
@@ -40,9 +42,10 @@ impl Tri {
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleBvh {
-    bvh: Bvh,
-    /// Triangles in leaf order; `bvh.indices[i]` is the original index of `tris[i]`.
+    nodes: Vec<Node8>,
+    /// Triangles in leaf order; `ids[i]` is the mesh's index of `tris[i]`.
     tris: Vec<Tri>,
+    ids: Vec<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,162 +55,412 @@ pub struct TriangleHit {
     pub triangle: u32,
 }
 
+/// Per-ray constants for the 8-wide slab test.
+struct RayPre {
+    o: Vec3,
+    d: Vec3,
+    inv: Vec3,
+    /// Per axis: does the ray run toward -axis (so it enters through the max plane)?
+    neg: [bool; 3],
+}
+
+impl RayPre {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        // One packed division rather than three scalar ones on every ray's critical path.
+        let inv = Vec3::from(glam::Vec3A::from(ray.direction).recip());
+        RayPre {
+            o: ray.origin,
+            d: ray.direction,
+            inv,
+            neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+        }
+    }
+
+    /// Entry distances of all eight slots into `tn`; bit i of the result is set when slot i
+    /// is entered within [t_min, t_max].
+    #[inline(always)]
+    fn slab8(&self, n: &Node8, t_min: f32, t_max: f32, tn: &mut [f32; WIDTH]) -> u32 {
+        let pick = |a: usize| {
+            if self.neg[a] {
+                (&n.hi[a], &n.lo[a])
+            } else {
+                (&n.lo[a], &n.hi[a])
+            }
+        };
+        let (nx, fx) = pick(0);
+        let (ny, fy) = pick(1);
+        let (nz, fz) = pick(2);
+        let (o, inv) = (self.o, self.inv);
+        let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
+        let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
+        let (t0, t1) = (Vec4::splat(t_min), Vec4::splat(t_max));
+        let mut mask = 0u32;
+        let mut near = [Vec4::ZERO; 2];
+        for h in 0..2 {
+            // maxps/minps return the second operand when the first is NaN (0 * inf on an
+            // axis-parallel ray), so that axis drops out instead of poisoning the result.
+            let a = ((nx[h] - ox) * ix)
+                .max((ny[h] - oy) * iy)
+                .max(((nz[h] - oz) * iz).max(t0));
+            let b = ((fx[h] - ox) * ix)
+                .min((fy[h] - oy) * iy)
+                .min(((fz[h] - oz) * iz).min(t1));
+            // Widened by a few ulps so rounding never loses a box the ray grazes.
+            mask |= a.cmple(b * 1.000_000_4).bitmask() << (4 * h);
+            near[h] = a;
+        }
+        let (lo, hi) = tn.split_at_mut(4);
+        lo.copy_from_slice(&near[0].to_array());
+        hi.copy_from_slice(&near[1].to_array());
+        mask
+    }
+}
+
+/// The closest-hit traversal, expanded once per slab test so each copy is compiled for the
+/// instruction set its function enables.
+macro_rules! closest_hit {
+    ($self:ident, $ray:expr, $t_min:expr, $t_max:expr, $slab:expr) => {{
+        let (ray, t_min, t_max) = ($ray, $t_min, $t_max);
+        if $self.nodes.is_empty() {
+            return None;
+        }
+        let r = RayPre::new(ray);
+        let mut t_best = t_max;
+        let mut best = usize::MAX;
+        let mut stack = RayStack::new();
+        let mut tn = [0.0f32; WIDTH];
+        let mut cur: Child = 0;
+        loop {
+            if wide::is_leaf(cur) {
+                let (first, count) = wide::leaf_range(cur);
+                // One bounds check per leaf, not per triangle.
+                for (k, tri) in $self
+                    .tris
+                    .get(first..first + count)
+                    .unwrap_or(&[])
+                    .iter()
+                    .enumerate()
+                {
+                    if let Some(t) = tri.hit(r.o, r.d) {
+                        if t > t_min && t < t_best {
+                            t_best = t;
+                            best = first + k;
+                        }
+                    }
+                }
+            } else {
+                let n = &$self.nodes[cur as usize];
+                let mask = $slab(&r, n, t_min, t_best, &mut tn);
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = n.child[i];
+                        continue;
+                    }
+                    if rest & (rest - 1) == 0 {
+                        // Two children, the common case below the top: no sort needed.
+                        let j = rest.trailing_zeros() as usize;
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push(n.child[far], tn[far]);
+                        cur = n.child[near];
+                        continue;
+                    }
+                    // Several children: push them all, nearest on top, and take the nearest.
+                    let mut m = mask;
+                    let mut k = 0;
+                    while m != 0 {
+                        let j = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        stack.push(n.child[j], tn[j]);
+                        k += 1;
+                    }
+                    stack.sort_top(k);
+                    if let Some((c, _)) = stack.pop() {
+                        cur = c;
+                        continue;
+                    }
+                }
+            }
+            // Pop the nearest child not ruled out by a closer hit found since it was pushed.
+            loop {
+                match stack.pop() {
+                    None => {
+                        return (best != usize::MAX).then(|| TriangleHit {
+                            t: t_best,
+                            triangle: $self.ids[best],
+                        });
+                    }
+                    Some((c, t)) if t <= t_best => {
+                        cur = c;
+                        break;
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+    }};
+}
+
 impl TriangleBvh {
+    /// Builds over the mesh. Vertex indices out of range read as the origin (the loaders
+    /// reject them); triangles beyond 2^28 are left out.
     pub fn build(positions: &[Vec3], triangles: &[[u32; 3]]) -> TriangleBvh {
+        let triangles = &triangles[..triangles.len().min(wide::MAX_TRIANGLES)];
         let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-        let bounds: Vec<Aabb> = triangles
+        let mut prims: Vec<PrimRef> = triangles
             .par_iter()
-            .map(|t| Aabb::EMPTY.grow(vert(t[0])).grow(vert(t[1])).grow(vert(t[2])))
-            .collect();
-        let bvh = Bvh::build(&bounds);
-        let tris: Vec<Tri> = bvh
-            .indices
-            .par_iter()
-            .map(|&i| {
-                let t = triangles[i as usize];
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(i, t)| {
                 let (a, b, c) = (vert(t[0]), vert(t[1]), vert(t[2]));
-                Tri { v0: a, e1: b - a, e2: c - a }
+                PrimRef::new(Aabb::new(a.min(b).min(c), a.max(b).max(c)), i as u32)
             })
             .collect();
-        TriangleBvh { bvh, tris }
+        let Some(root) = sah::build(&mut prims) else {
+            return TriangleBvh::default();
+        };
+        let nodes = wide::collapse(&root);
+        // The temporary tree is freed on another thread while the triangles are copied.
+        let ((tris, ids), ()) = rayon::join(
+            || {
+                prims
+                    .par_iter()
+                    .with_min_len(4096)
+                    .map(|p| {
+                        let t = triangles[p.id as usize];
+                        let (a, b, c) = (vert(t[0]), vert(t[1]), vert(t[2]));
+                        (
+                            Tri {
+                                v0: a,
+                                e1: b - a,
+                                e2: c - a,
+                            },
+                            p.id,
+                        )
+                    })
+                    .unzip()
+            },
+            move || drop(root),
+        );
+        TriangleBvh { nodes, tris, ids }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        let Some(root) = self.nodes.first() else {
+            return Aabb::EMPTY;
+        };
+        (0..WIDTH)
+            .filter(|&i| !root.slot_is_empty(i))
+            .fold(Aabb::EMPTY, |b, i| b.union(root.slot_bounds(i)))
+    }
+
+    /// Bytes held by the nodes and the triangle copies.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node8>()
+            + self.tris.len() * std::mem::size_of::<Tri>()
+            + self.ids.len() * 4
     }
 
     /// Checks the BVH invariants against the mesh it was built from (for tests): every
-    /// triangle in exactly one leaf, children inside their parents' bounds.
-    pub fn check_invariants(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), String> {
+    /// triangle in exactly one leaf, every leaf box around its triangles, every node's boxes
+    /// inside the box its parent holds for it, each node reached once, depth within the cap.
+    pub fn check_invariants(
+        &self,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<(), String> {
         let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-        let bounds: Vec<Aabb> =
-            triangles.iter().map(|t| Aabb::EMPTY.grow(vert(t[0])).grow(vert(t[1])).grow(vert(t[2]))).collect();
-        self.bvh.check_invariants(&bounds)
+        let tri_box = |t: &[u32; 3]| Aabb::from_points(&[vert(t[0]), vert(t[1]), vert(t[2])]);
+        if triangles.is_empty() {
+            return if self.nodes.is_empty() && self.tris.is_empty() {
+                Ok(())
+            } else {
+                Err("nodes or triangles for an empty mesh".into())
+            };
+        }
+        if self.tris.len() != triangles.len() || self.ids.len() != triangles.len() {
+            return Err(format!(
+                "{} triangles stored for {}",
+                self.tris.len(),
+                triangles.len()
+            ));
+        }
+        let mut seen = vec![0u32; triangles.len()];
+        let mut reached = vec![0u32; self.nodes.len()];
+        // (node, the box its parent holds for it, depth)
+        let mut stack = vec![(0usize, None::<Aabb>, 0usize)];
+        while let Some((i, parent_box, depth)) = stack.pop() {
+            let n = self.nodes.get(i).ok_or(format!("node {i} out of range"))?;
+            reached[i] += 1;
+            if depth > sah::MAX_DEPTH {
+                return Err(format!("node {i} at depth {depth}, past the cap"));
+            }
+            let mut used = 0;
+            for s in 0..WIDTH {
+                if n.slot_is_empty(s) {
+                    continue;
+                }
+                used += 1;
+                let b = n.slot_bounds(s);
+                if let Some(pb) = parent_box
+                    && !pb.contains(&b)
+                {
+                    return Err(format!("node {i} slot {s} escapes its parent's box"));
+                }
+                let c = n.child[s];
+                if wide::is_leaf(c) {
+                    let (first, count) = wide::leaf_range(c);
+                    let ids = self
+                        .ids
+                        .get(first..first + count)
+                        .ok_or(format!("leaf range {first}+{count} out of bounds"))?;
+                    for &id in ids {
+                        let t = triangles
+                            .get(id as usize)
+                            .ok_or(format!("bad triangle id {id}"))?;
+                        if !b.contains(&tri_box(t)) {
+                            return Err(format!(
+                                "leaf box in node {i} does not contain triangle {id}"
+                            ));
+                        }
+                        seen[id as usize] += 1;
+                    }
+                } else {
+                    stack.push((c as usize, Some(b), depth + 1));
+                }
+            }
+            if used == 0 {
+                return Err(format!("node {i} has no children"));
+            }
+        }
+        if let Some(p) = seen.iter().position(|&s| s != 1) {
+            return Err(format!("triangle {p} appears in {} leaves", seen[p]));
+        }
+        if let Some(p) = reached.iter().position(|&r| r != 1) {
+            return Err(format!("node {p} reached {} times", reached[p]));
+        }
+        // The stored copies must be the mesh's triangles, in leaf order.
+        for (k, (tri, &id)) in self.tris.iter().zip(&self.ids).enumerate() {
+            let t = triangles[id as usize];
+            if tri.v0 != vert(t[0]) || tri.v0 + tri.e1 != vert(t[0]) + (vert(t[1]) - vert(t[0])) {
+                return Err(format!("stored triangle {k} is not mesh triangle {id}"));
+            }
+        }
+        Ok(())
     }
 
     /// Every hit with t in (t_min, t_max), in no particular order, appended to `out`. CSG
     /// needs all crossings of a closed mesh along a ray, not just the nearest.
     pub fn intersect_all(&self, ray: &Ray, t_min: f32, t_max: f32, out: &mut Vec<TriangleHit>) {
-        let nodes = &self.bvh.nodes;
-        if nodes.is_empty() {
+        if self.nodes.is_empty() {
             return;
         }
-        let (o, d) = (ray.origin, ray.direction);
-        let inv = d.recip();
-        let mut stack = vec![0usize];
-        while let Some(idx) = stack.pop() {
-            let node = &nodes[idx];
-            if node.bounds().hit(o, inv, t_min, t_max).is_none() {
-                continue;
-            }
-            if node.count > 0 {
-                let first = node.right_or_first as usize;
-                for k in first..first + node.count as usize {
-                    if let Some(t) = self.tris[k].hit(o, d) {
-                        if t > t_min && t < t_max {
-                            out.push(TriangleHit { t, triangle: self.bvh.indices[k] });
-                        }
+        let r = RayPre::new(ray);
+        let mut stack = RayStack::new();
+        let mut tn = [0.0f32; WIDTH];
+        stack.push(0, t_min);
+        while let Some((c, _)) = stack.pop() {
+            if wide::is_leaf(c) {
+                let (first, count) = wide::leaf_range(c);
+                for k in first..first + count {
+                    if let Some(t) = self.tris[k].hit(r.o, r.d)
+                        && t > t_min
+                        && t < t_max
+                    {
+                        out.push(TriangleHit {
+                            t,
+                            triangle: self.ids[k],
+                        });
                     }
                 }
-            } else {
-                stack.push(idx + 1);
-                stack.push(node.right_or_first as usize);
+                continue;
+            }
+            let n = &self.nodes[c as usize];
+            let mut mask = r.slab8(n, t_min, t_max, &mut tn);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.push(n.child[i], tn[i]);
             }
         }
-    }
-
-    pub fn bounds(&self) -> Aabb {
-        self.bvh.bounds()
-    }
-
-    /// Bytes held by the BVH and its triangle copies.
-    pub fn memory_bytes(&self) -> usize {
-        self.bvh.nodes.len() * std::mem::size_of::<super::BvhNode>()
-            + self.bvh.indices.len() * 4
-            + self.tris.len() * std::mem::size_of::<Tri>()
     }
 
     /// Closest hit in (t_min, t_max). Two-sided Möller–Trumbore.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
-        let mut best: Option<u32> = None;
-        let nodes = &self.bvh.nodes;
-        if nodes.is_empty() {
-            return None;
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above (std caches the answer).
+            return unsafe { self.intersect_avx(ray, t_min, t_max) };
         }
-        let o = ray.origin;
-        let d = ray.direction;
-        let inv = d.recip();
-        let mut t_best = t_max;
-        let mut stack = [0u32; 64];
-        let mut sp = 0usize;
-        let mut idx = 0usize;
-        if nodes[0].bounds().hit(o, inv, t_min, t_best).is_none() {
-            return None;
-        }
-        loop {
-            let node = &nodes[idx];
-            if node.count > 0 {
-                let first = node.right_or_first as usize;
-                for k in first..first + node.count as usize {
-                    let tri = &self.tris[k];
-                    let p = d.cross(tri.e2);
-                    let det = tri.e1.dot(p);
-                    if det == 0.0 {
-                        continue;
-                    }
-                    let inv_det = 1.0 / det;
-                    let s = o - tri.v0;
-                    let u = s.dot(p) * inv_det;
-                    if !(0.0..=1.0).contains(&u) {
-                        continue;
-                    }
-                    let q = s.cross(tri.e1);
-                    let v = d.dot(q) * inv_det;
-                    if v < 0.0 || u + v > 1.0 {
-                        continue;
-                    }
-                    let t = tri.e2.dot(q) * inv_det;
-                    if t > t_min && t < t_best {
-                        t_best = t;
-                        best = Some(k as u32);
-                    }
-                }
-            } else {
-                let l = idx + 1;
-                let r = node.right_or_first as usize;
-                let tl = nodes[l].bounds().hit(o, inv, t_min, t_best);
-                let tr = nodes[r].bounds().hit(o, inv, t_min, t_best);
-                match (tl, tr) {
-                    (Some(a), Some(b)) => {
-                        let (near, far) = if a <= b { (l, r) } else { (r, l) };
-                        if sp < stack.len() {
-                            stack[sp] = far as u32;
-                            sp += 1;
-                        }
-                        idx = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        idx = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        idx = r;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            loop {
-                if sp == 0 {
-                    return best.map(|k| TriangleHit { t: t_best, triangle: self.bvh.indices[k as usize] });
-                }
-                sp -= 1;
-                let n = stack[sp] as usize;
-                if nodes[n].bounds().hit(o, inv, t_min, t_best).is_some() {
-                    idx = n;
-                    break;
-                }
-            }
-        }
+        self.intersect_portable(ray, t_min, t_max)
     }
+
+    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
+    #[inline(always)]
+    fn intersect_portable(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        closest_hit!(self, ray, t_min, t_max, RayPre::slab8)
+    }
+
+    /// The 8 slots in one 256-bit register. Measured (best of 20 frames, 800x800, 1 thread):
+    /// bunny69k 8.77 -> 8.93 Mrays/s, dragon 7.55 -> 7.88, bunny_1k unchanged.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn intersect_avx(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        closest_hit!(self, ray, t_min, t_max, slab8_avx)
+    }
+}
+
+/// `RayPre::slab8` with AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+fn slab8_avx(r: &RayPre, n: &Node8, t_min: f32, t_max: f32, tn: &mut [f32; WIDTH]) -> u32 {
+    use std::arch::x86_64::*;
+    #[allow(unsafe_code)]
+    // SAFETY: an axis row [Vec4; 2] is 8 contiguous f32 (Vec4 is a 16-byte __m128);
+    // unaligned loads ask nothing more.
+    let ld = |v: &[Vec4; 2]| unsafe { _mm256_loadu_ps(v.as_ptr().cast::<f32>()) };
+    let pick = |a: usize| {
+        if r.neg[a] {
+            (&n.hi[a], &n.lo[a])
+        } else {
+            (&n.lo[a], &n.hi[a])
+        }
+    };
+    let (nx, fx) = pick(0);
+    let (ny, fy) = pick(1);
+    let (nz, fz) = pick(2);
+    let (ox, oy, oz) = (
+        _mm256_set1_ps(r.o.x),
+        _mm256_set1_ps(r.o.y),
+        _mm256_set1_ps(r.o.z),
+    );
+    let (ix, iy, iz) = (
+        _mm256_set1_ps(r.inv.x),
+        _mm256_set1_ps(r.inv.y),
+        _mm256_set1_ps(r.inv.z),
+    );
+    let slab = |p: &[Vec4; 2], o: __m256, i: __m256| _mm256_mul_ps(_mm256_sub_ps(ld(p), o), i);
+    // Operand order as in the SSE version: NaN in the first operand yields the second.
+    let near = _mm256_max_ps(
+        _mm256_max_ps(slab(nx, ox, ix), slab(ny, oy, iy)),
+        _mm256_max_ps(slab(nz, oz, iz), _mm256_set1_ps(t_min)),
+    );
+    let far = _mm256_min_ps(
+        _mm256_min_ps(slab(fx, ox, ix), slab(fy, oy, iy)),
+        _mm256_min_ps(slab(fz, oz, iz), _mm256_set1_ps(t_max)),
+    );
+    let far = _mm256_mul_ps(far, _mm256_set1_ps(1.000_000_4));
+    #[allow(unsafe_code)]
+    // SAFETY: `tn` is 8 f32, exactly one unaligned 256-bit store.
+    unsafe {
+        _mm256_storeu_ps(tn.as_mut_ptr(), near)
+    };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
 }
 
 #[cfg(test)]
@@ -215,85 +468,272 @@ mod tests {
     use super::*;
     use crate::geometry::intersect_triangle;
 
+    /// xorshift32: repeatable runs.
+    struct Rng(u32);
+    impl Rng {
+        fn f(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            self.0 as f32 / u32::MAX as f32
+        }
+        fn v(&mut self) -> Vec3 {
+            Vec3::new(self.f(), self.f(), self.f())
+        }
+    }
+
     fn random_mesh(n: usize, seed: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let mut s = seed.max(1);
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s as f32 / u32::MAX as f32
-        };
+        let mut r = Rng(seed.max(1));
         let mut pos = Vec::new();
         let mut tris = Vec::new();
         for i in 0..n {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0 - 2.0;
+            let c = r.v() * 4.0 - 2.0;
             for _ in 0..3 {
-                pos.push(c + (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * 0.6);
+                pos.push(c + (r.v() - 0.5) * 0.6);
             }
             let b = (3 * i) as u32;
             tris.push([b, b + 1, b + 2]);
         }
-        // A degenerate triangle too.
-        pos.push(Vec3::ZERO);
-        let z = (pos.len() - 1) as u32;
+        // Degenerate triangles too: a point and a sliver along a line.
+        pos.extend([Vec3::ZERO, Vec3::X, Vec3::X * 2.0]);
+        let z = (pos.len() - 3) as u32;
         tris.push([z, z, z]);
+        tris.push([z, z + 1, z + 2]);
         (pos, tris)
     }
 
-    fn brute(pos: &[Vec3], tris: &[[u32; 3]], ray: &Ray) -> Option<TriangleHit> {
+    fn build_checked(pos: &[Vec3], tris: &[[u32; 3]]) -> TriangleBvh {
+        let bvh = TriangleBvh::build(pos, tris);
+        bvh.check_invariants(pos, tris)
+            .unwrap_or_else(|e| panic!("{} triangles: {e}", tris.len()));
+        bvh
+    }
+
+    fn brute(pos: &[Vec3], tris: &[[u32; 3]], ray: &Ray, t_min: f32) -> Option<TriangleHit> {
         let mut best: Option<TriangleHit> = None;
         for (i, t) in tris.iter().enumerate() {
             let lim = best.map_or(f32::INFINITY, |b| b.t);
-            if let Some((th, _, _)) =
-                intersect_triangle(ray, pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize], 0.0, lim)
-            {
-                best = Some(TriangleHit { t: th, triangle: i as u32 });
+            let [a, b, c] = t.map(|v| pos[v as usize]);
+            if let Some((th, _, _)) = intersect_triangle(ray, a, b, c, t_min, lim) {
+                best = Some(TriangleHit {
+                    t: th,
+                    triangle: i as u32,
+                });
             }
         }
         best
     }
 
-    #[test]
-    fn random_rays_agree_with_brute_force() {
-        for (n, seed) in [(1, 7), (50, 11), (2000, 13)] {
-            let (pos, tris) = random_mesh(n, seed);
-            let bvh = TriangleBvh::build(&pos, &tris);
-            bvh.check_invariants(&pos, &tris).expect("invariants");
-            let mut s = 99u32;
-            let mut rnd = || {
-                s ^= s << 13;
-                s ^= s >> 17;
-                s ^= s << 5;
-                s as f32 / u32::MAX as f32
-            };
-            for _ in 0..2000 {
-                let o = Vec3::new(rnd(), rnd(), rnd()) * 8.0 - 4.0;
-                let target = Vec3::new(rnd(), rnd(), rnd()) * 3.0 - 1.5;
-                let ray = Ray::new(o, target - o);
-                let a = bvh.intersect(&ray, 0.0, f32::INFINITY);
-                let b = brute(&pos, &tris, &ray);
-                match (a, b) {
-                    (None, None) => {}
-                    (Some(a), Some(b)) => {
-                        assert!((a.t - b.t).abs() <= 1e-5 * b.t.abs().max(1.0), "t {a:?} vs {b:?}");
-                        if a.triangle != b.triangle {
-                            // Ties between coincident triangles are fine if t matches.
-                            assert!((a.t - b.t).abs() < 1e-6);
-                        }
+    /// Closest hits agree with the brute-force loop: same t, and the same triangle unless
+    /// two triangles are hit at that very t.
+    fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray]) {
+        for (k, ray) in rays.iter().enumerate() {
+            let a = bvh.intersect(ray, 0.0, f32::INFINITY);
+            // Whichever instruction set `intersect` picked, the portable path must agree.
+            assert_eq!(
+                a,
+                bvh.intersect_portable(ray, 0.0, f32::INFINITY),
+                "ray {k}"
+            );
+            let b = brute(pos, tris, ray, 0.0);
+            match (a, b) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert!(
+                        (a.t - b.t).abs() <= 1e-6 * b.t.abs().max(1.0),
+                        "ray {k}: t {a:?} vs {b:?}"
+                    );
+                    if a.triangle != b.triangle {
+                        let [p, q, r] = tris[a.triangle as usize].map(|v| pos[v as usize]);
+                        let again =
+                            intersect_triangle(ray, p, q, r, 0.0, f32::INFINITY).map(|h| h.0);
+                        assert_eq!(
+                            again,
+                            Some(a.t),
+                            "ray {k}: triangle {} is not hit at {}",
+                            a.triangle,
+                            a.t
+                        );
                     }
-                    _ => panic!("bvh {a:?} vs brute {b:?}"),
                 }
+                _ => panic!("ray {k}: bvh {a:?} vs brute {b:?}"),
             }
         }
+    }
+
+    fn rays_toward(center: Vec3, radius: f32, n: usize, seed: u32) -> Vec<Ray> {
+        let mut r = Rng(seed);
+        (0..n)
+            .map(|_| {
+                let o = center + (r.v() * 2.0 - 1.0) * radius * 2.5;
+                let target = center + (r.v() * 2.0 - 1.0) * radius * 0.8;
+                Ray::new(o, target - o)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn random_rays_agree_with_brute_force_on_random_meshes() {
+        for (n, seed) in [(1, 7), (3, 3), (9, 1), (50, 11), (2000, 13), (20_000, 17)] {
+            let (pos, tris) = random_mesh(n, seed);
+            let bvh = build_checked(&pos, &tris);
+            assert_agrees(
+                &pos,
+                &tris,
+                &bvh,
+                &rays_toward(Vec3::ZERO, 2.0, 2000, 99 + seed),
+            );
+        }
+    }
+
+    #[test]
+    fn a_ray_from_inside_the_mesh_and_axis_parallel_rays_agree() {
+        let (pos, tris) = random_mesh(3000, 23);
+        let bvh = build_checked(&pos, &tris);
+        let mut rays = Vec::new();
+        let mut r = Rng(5);
+        for _ in 0..500 {
+            let o = r.v() * 3.0 - 1.5;
+            for d in [
+                Vec3::X,
+                Vec3::NEG_X,
+                Vec3::Y,
+                Vec3::NEG_Y,
+                Vec3::Z,
+                Vec3::NEG_Z,
+                r.v() - 0.5,
+            ] {
+                rays.push(Ray::new(o, d));
+            }
+        }
+        assert_agrees(&pos, &tris, &bvh, &rays);
+    }
+
+    #[test]
+    fn t_range_is_respected() {
+        let (pos, tris) = random_mesh(500, 29);
+        let bvh = build_checked(&pos, &tris);
+        for ray in rays_toward(Vec3::ZERO, 2.0, 500, 3) {
+            let Some(first) = bvh.intersect(&ray, 0.0, f32::INFINITY) else {
+                continue;
+            };
+            // Nothing strictly before the first hit; past it, the brute force's next hit.
+            assert!(bvh.intersect(&ray, 0.0, first.t).is_none());
+            let next = bvh.intersect(&ray, first.t, f32::INFINITY).map(|h| h.t);
+            let want = brute(&pos, &tris, &ray, first.t).map(|h| h.t);
+            assert_eq!(next, want);
+        }
+    }
+
+    #[test]
+    fn identical_and_degenerate_triangles_build_and_never_hit_edge_on() {
+        // Many copies of one triangle: no split can separate them; leaves must still be small.
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tris = vec![[0, 1, 2]; 1000];
+        let bvh = build_checked(&pos, &tris);
+        let hit = bvh.intersect(
+            &Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::NEG_Z),
+            0.0,
+            f32::INFINITY,
+        );
+        assert_eq!(hit.map(|h| h.t), Some(1.0));
+        // Zero-area triangles only.
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+        let tris = vec![[0, 0, 0], [0, 1, 2], [1, 1, 2]];
+        let bvh = build_checked(&pos, &tris);
+        for ray in rays_toward(Vec3::X, 1.0, 200, 8) {
+            assert!(bvh.intersect(&ray, 0.0, f32::INFINITY).is_none());
+        }
+    }
+
+    #[test]
+    fn adversarial_sizes_stay_within_the_depth_cap() {
+        // Triangles at exponentially growing distances make SAH peel one at a time.
+        let mut pos = Vec::new();
+        let mut tris = Vec::new();
+        for i in 0..3000u32 {
+            let x = 1.02f32.powi(i as i32);
+            pos.extend([
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            ]);
+            tris.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let bvh = build_checked(&pos, &tris);
+        let ray = Ray::new(Vec3::new(-1.0, 0.2, 0.2), Vec3::X);
+        assert_eq!(
+            bvh.intersect(&ray, 0.0, f32::INFINITY).map(|h| h.triangle),
+            Some(0)
+        );
+        let mut all = Vec::new();
+        bvh.intersect_all(&ray, 0.0, f32::INFINITY, &mut all);
+        assert_eq!(all.len(), 3000);
+    }
+
+    #[test]
+    fn one_triangle_mesh() {
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let bvh = build_checked(&pos, &[[0, 1, 2]]);
+        let ray = Ray::new(Vec3::new(0.25, 0.25, -2.0), Vec3::Z);
+        assert_eq!(
+            bvh.intersect(&ray, 0.0, f32::INFINITY),
+            Some(TriangleHit {
+                t: 2.0,
+                triangle: 0
+            })
+        );
+        assert!(
+            bvh.intersect(
+                &Ray::new(Vec3::new(0.8, 0.8, -2.0), Vec3::Z),
+                0.0,
+                f32::INFINITY
+            )
+            .is_none()
+        );
+        assert_eq!(
+            bvh.bounds(),
+            Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))
+        );
+    }
+
+    #[test]
+    fn empty_mesh_never_hits() {
+        let bvh = build_checked(&[], &[]);
+        assert!(
+            bvh.intersect(&Ray::new(Vec3::ZERO, Vec3::X), 0.0, f32::INFINITY)
+                .is_none()
+        );
+        let mut out = Vec::new();
+        bvh.intersect_all(&Ray::new(Vec3::ZERO, Vec3::X), 0.0, f32::INFINITY, &mut out);
+        assert!(out.is_empty());
+        assert!(bvh.bounds().is_empty());
+    }
+
+    #[test]
+    fn broken_trees_fail_the_invariant_check() {
+        let (pos, tris) = random_mesh(300, 31);
+        let good = build_checked(&pos, &tris);
+        let mut shrunk = good.clone();
+        shrunk.nodes[0].hi[0][0][0] -= 0.5;
+        assert!(shrunk.check_invariants(&pos, &tris).is_err());
+        let mut dup = good.clone();
+        dup.ids[1] = dup.ids[0];
+        assert!(dup.check_invariants(&pos, &tris).is_err());
+        assert!(good.check_invariants(&pos, &tris[1..]).is_err());
     }
 
     #[test]
     fn intersect_all_finds_every_crossing() {
         let (pos, tris) = random_mesh(500, 5);
-        let bvh = TriangleBvh::build(&pos, &tris);
+        let bvh = build_checked(&pos, &tris);
         let mut out = Vec::new();
         for k in 0..200 {
-            let o = Vec3::new(-5.0, (k as f32 * 0.37).sin() * 1.5, (k as f32 * 0.11).cos() * 1.5);
+            let o = Vec3::new(
+                -5.0,
+                (k as f32 * 0.37).sin() * 1.5,
+                (k as f32 * 0.11).cos() * 1.5,
+            );
             let ray = Ray::new(o, Vec3::new(1.0, 0.01 * k as f32 - 1.0, 0.3));
             out.clear();
             bvh.intersect_all(&ray, 0.0, f32::INFINITY, &mut out);
@@ -301,8 +741,7 @@ mod tests {
             got.sort_unstable();
             let want: Vec<u32> = (0..tris.len() as u32)
                 .filter(|&i| {
-                    let t = tris[i as usize];
-                    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+                    let [a, b, c] = tris[i as usize].map(|v| pos[v as usize]);
                     intersect_triangle(&ray, a, b, c, 0.0, f32::INFINITY).is_some()
                 })
                 .collect();
@@ -311,8 +750,38 @@ mod tests {
     }
 
     #[test]
-    fn empty_mesh_never_hits() {
-        let bvh = TriangleBvh::build(&[], &[]);
-        assert!(bvh.intersect(&Ray::new(Vec3::ZERO, Vec3::X), 0.0, f32::INFINITY).is_none());
+    fn shared_meshes_agree_with_brute_force() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
+        if !dir.is_dir() {
+            assert!(
+                std::env::var_os("TRACELAB_REQUIRE_SHARED").is_none(),
+                "{} is required here",
+                dir.display()
+            );
+            eprintln!(
+                "SKIPPED: {} not found; shared meshes not checked",
+                dir.display()
+            );
+            return;
+        }
+        // The dragon is left to the benchmark's checksums: brute force over 871k triangles
+        // per ray is too slow for a unit test.
+        for (name, rays) in [
+            ("cube.obj", 2000),
+            ("bunny_1k.obj", 2000),
+            ("stanford-bunny.obj", 150),
+        ] {
+            let mesh = crate::format::obj::load_obj(&dir.join(name))
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let bvh = build_checked(&mesh.positions, &mesh.triangles);
+            let b = bvh.bounds();
+            let radius = b.extent().max_element() * 0.5;
+            assert_agrees(
+                &mesh.positions,
+                &mesh.triangles,
+                &bvh,
+                &rays_toward(b.center(), radius, rays, 41),
+            );
+        }
     }
 }

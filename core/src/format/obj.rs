@@ -1,5 +1,8 @@
-//! Loading OBJ meshes with `tobj` (polygons triangulated; v, v/vt, v//vn, v/vt/vn faces),
-//! shared by path so a mesh used twice is read and its BVH built once.
+//! Loading OBJ meshes (polygons triangulated; v, v/vt, v//vn, v/vt/vn faces), shared by path
+//! so a mesh used twice is read and its BVH built once. Plain files go through a fast parallel
+//! reader; anything it does not understand goes to `tobj`, the reference.
+
+mod fast;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -18,14 +21,21 @@ pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, 
         if p.is_file() {
             return Ok(p);
         }
-        tried.push(if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
+        tried.push(if dir.as_os_str().is_empty() {
+            ".".to_string()
+        } else {
+            dir.display().to_string()
+        });
     }
     let p = PathBuf::from(name);
     if p.is_file() {
         return Ok(p);
     }
     tried.push("the current folder".to_string());
-    Err(format!("file not found (looked in {})", tried.join(" and ")))
+    Err(format!(
+        "file not found (looked in {})",
+        tried.join(" and ")
+    ))
 }
 
 /// Meshes already loaded, by canonical path; reused while the file is unchanged on disk.
@@ -62,7 +72,25 @@ impl MeshCache {
 
 /// Reads one OBJ file into a single mesh (all its objects and groups together).
 pub fn load_obj(path: &Path) -> Result<Mesh, String> {
-    let opts = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    let (positions, triangles) = match fast::parse(&bytes) {
+        Some(r) => r,
+        None => load_with_tobj(path)?,
+    };
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!("vertex {} is not finite", i + 1));
+    }
+    Ok(Mesh::new(positions, triangles))
+}
+
+/// The reference reader: every OBJ feature tobj knows, all objects and groups merged.
+fn load_with_tobj(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
     let (models, _materials) = match tobj::load_obj(path, &opts) {
         Ok(r) => r,
         Err(e) => return Err(locate_obj_error(path).unwrap_or_else(|| e.to_string())),
@@ -71,30 +99,40 @@ pub fn load_obj(path: &Path) -> Result<Mesh, String> {
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     for m in &models {
         let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        positions.extend(
+            m.mesh
+                .positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
         let nv = positions.len() as u32;
         for t in m.mesh.indices.chunks_exact(3) {
             let tri = [t[0] + base, t[1] + base, t[2] + base];
             if tri.iter().any(|&i| i >= nv) {
-                return Err(locate_obj_error(path).unwrap_or_else(|| "a face refers to a vertex that does not exist".into()));
+                return Err(locate_obj_error(path)
+                    .unwrap_or_else(|| "a face refers to a vertex that does not exist".into()));
             }
             triangles.push(tri);
         }
     }
-    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(format!("vertex {} is not finite", i + 1));
-    }
-    Ok(Mesh::new(positions, triangles))
+    Ok((positions, triangles))
 }
 
 /// tobj's errors carry no line; find the first line that is wrong, to say where.
 fn locate_obj_error(path: &Path) -> Option<String> {
     let bytes = std::fs::read(path).ok()?;
-    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
     let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t,
         Err(e) => {
-            let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+            let line = bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
             return Some(format!("{name}:{line}: not a text OBJ file"));
         }
     };
@@ -105,21 +143,36 @@ fn locate_obj_error(path: &Path) -> Option<String> {
         match words.next() {
             Some("v") => {
                 let coords: Vec<&str> = words.collect();
-                if coords.len() < 3 || coords.iter().take(3).any(|c| c.parse::<f32>().map_or(true, |v| !v.is_finite())) {
-                    return at(format!("bad vertex \"{}\": expected three numbers", line.trim()));
+                if coords.len() < 3
+                    || coords
+                        .iter()
+                        .take(3)
+                        .any(|c| c.parse::<f32>().map_or(true, |v| !v.is_finite()))
+                {
+                    return at(format!(
+                        "bad vertex \"{}\": expected three numbers",
+                        line.trim()
+                    ));
                 }
                 nv += 1;
             }
             Some("f") => {
                 let verts: Vec<&str> = words.collect();
                 if verts.len() < 3 {
-                    return at(format!("face \"{}\" has fewer than three vertices", line.trim()));
+                    return at(format!(
+                        "face \"{}\" has fewer than three vertices",
+                        line.trim()
+                    ));
                 }
                 for v in verts {
                     let idx = v.split('/').next().unwrap_or("");
                     match idx.parse::<i64>() {
                         Ok(i) if (i > 0 && i <= nv) || (i < 0 && -i <= nv) => {}
-                        Ok(i) => return at(format!("face refers to vertex {i}, but only {nv} vertices come before it")),
+                        Ok(i) => {
+                            return at(format!(
+                                "face refers to vertex {i}, but only {nv} vertices come before it"
+                            ));
+                        }
                         Err(_) => return at(format!("bad face index \"{v}\"")),
                     }
                 }
@@ -144,7 +197,10 @@ mod tests {
 
     #[test]
     fn quads_are_triangulated_and_slash_forms_accepted() {
-        let p = write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n");
+        let p = write(
+            "quad.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n",
+        );
         let m = load_obj(&p).expect("load");
         assert_eq!(m.triangle_count(), 2);
     }
@@ -154,6 +210,62 @@ mod tests {
         let p = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n");
         let e = load_obj(&p).expect_err("must fail");
         assert!(e.contains("bad.obj:4"), "{e}");
+    }
+
+    /// The same triangles, as vertex positions, from the fast reader and from tobj.
+    fn same_geometry(path: &Path) {
+        let bytes = std::fs::read(path).expect("read");
+        let (fp, ft) = fast::parse(&bytes).expect("fast reader accepts the file");
+        let (tp, tt) = load_with_tobj(path).expect("tobj");
+        assert_eq!(ft.len(), tt.len(), "{}", path.display());
+        for (k, (a, b)) in ft.iter().zip(&tt).enumerate() {
+            let pa = a.map(|i| fp[i as usize]);
+            let pb = b.map(|i| tp[i as usize]);
+            assert_eq!(pa, pb, "{} triangle {k}", path.display());
+        }
+    }
+
+    #[test]
+    fn fast_reader_matches_tobj_on_polygons_and_slash_forms() {
+        let p = write(
+            "poly.obj",
+            "# c\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 2 1e-3\nvn 0 0 1\nvt 0 0\ng a\n\
+             f 1//1 2//1 3//1 4//1\ns off\nf 1/1/1 3/1/1 5/1/1\r\nf 5 4 3 2 1\n",
+        );
+        same_geometry(&p);
+    }
+
+    #[test]
+    fn fast_reader_defers_to_tobj_on_what_it_does_not_know() {
+        for (name, text) in [
+            ("neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"),
+            ("later.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"),
+            ("w.obj", "v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\nf 1 2 3\n"),
+            ("line.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"),
+        ] {
+            assert!(fast::parse(text.as_bytes()).is_none(), "{name}");
+        }
+        // tobj still reads what the fast reader declines.
+        let p = write("neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n");
+        assert_eq!(load_obj(&p).expect("load").triangle_count(), 1);
+    }
+
+    #[test]
+    fn fast_reader_matches_tobj_on_the_shared_meshes() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
+        if !dir.is_dir() {
+            assert!(
+                std::env::var("TRACELAB_REQUIRE_SHARED").as_deref() != Ok("1"),
+                "{} missing",
+                dir.display()
+            );
+            eprintln!("SKIPPED: {} not found", dir.display());
+            return;
+        }
+        // The dragon takes tobj seconds in a debug build; the smaller meshes cover the format.
+        for name in ["cube.obj", "bunny_1k.obj", "stanford-bunny.obj"] {
+            same_geometry(&dir.join(name));
+        }
     }
 
     #[test]

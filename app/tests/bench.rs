@@ -1,0 +1,136 @@
+//! `tracelab bench` and `tracelab bench-progressive` as ../shared/perf/compare.sh and a
+//! reader of docs/perf.md use them: the last line's format, and checksums against rays
+//! computed here independently, with the camera formula of ../shared/perf/embree_bench.cpp.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn tracelab(args: &[&str], dir: &PathBuf) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run tracelab")
+}
+
+/// A scene with a 2×2 quad (two triangles, in an OBJ file) at z = 0, seen from z = 5.
+fn quad_scene(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tracelab-bench-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    std::fs::write(
+        d.join("quad.obj"),
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .expect("obj");
+    std::fs::write(
+        d.join("quad.txt"),
+        "PerspectiveCamera { center 0 0 5 direction 0 0 -1 up 0 1 0 angle 60 }\n\
+         Lights { numLights 0 }\n\
+         Background { color 0 0 0 }\n\
+         Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n\
+         Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file quad.obj } }\n",
+    )
+    .expect("scene");
+    d
+}
+
+/// (hits, sum of t) for the quad, pixel centres, full vertical field of view.
+fn expected(w: u32, h: u32) -> (u64, f64) {
+    let half = (30f64).to_radians().tan();
+    let (mut hits, mut sum) = (0, 0.0);
+    for j in 0..h {
+        for i in 0..w {
+            let x = (2.0 * (i as f64 + 0.5) - w as f64) / h as f64 * half;
+            let y = (h as f64 - 2.0 * (j as f64 + 0.5)) / h as f64 * half;
+            // The ray (x, y, -1) meets z = 0 at 5·(x, y); t is the distance travelled.
+            if (5.0 * x).abs() < 1.0 && (5.0 * y).abs() < 1.0 {
+                hits += 1;
+                sum += 5.0 * (x * x + y * y + 1.0).sqrt();
+            }
+        }
+    }
+    (hits, sum)
+}
+
+fn field(line: &str, key: &str) -> f64 {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(&format!("{key}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key}= in {line:?}"))
+}
+
+#[test]
+fn bench_last_line_carries_the_checksums_of_the_embree_rays() {
+    let d = quad_scene("checksums");
+    // Square, as compare.sh runs it: for other shapes tracelab follows the course (the larger
+    // side spans the angle) and Embree's formula the height.
+    let (want_hits, want_sum) = expected(64, 64);
+    assert!(want_hits > 100, "the quad must cover part of the image");
+    for threads in ["1", "2"] {
+        let o = tracelab(
+            &[
+                "bench",
+                "quad.txt",
+                "--size",
+                "64",
+                "64",
+                "--threads",
+                threads,
+                "--repeat",
+                "2",
+            ],
+            &d,
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let out = String::from_utf8_lossy(&o.stdout);
+        let last = out.lines().last().unwrap_or_default();
+        assert!(
+            last.starts_with("BENCH mrays_per_s="),
+            "last line: {last:?}"
+        );
+        assert!(field(last, "mrays_per_s") > 0.0);
+        assert!(field(last, "build_ms") >= 0.0);
+        assert_eq!(field(last, "hits") as u64, want_hits, "{threads} threads");
+        let sum = field(last, "sum_t");
+        assert!(
+            (sum - want_sum).abs() <= 1e-5 * want_sum,
+            "{threads} threads: sum_t {sum} vs {want_sum}"
+        );
+        assert!(
+            out.contains("bytes/triangle"),
+            "memory per triangle is printed:\n{out}"
+        );
+    }
+}
+
+#[test]
+fn bench_progressive_reports_coarse_before_full() {
+    let d = quad_scene("progressive");
+    let o = tracelab(
+        &[
+            "bench-progressive",
+            "quad.txt",
+            "--size",
+            "64",
+            "64",
+            "--repeat",
+            "2",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let last = out.lines().last().unwrap_or_default();
+    assert!(last.starts_with("PROGRESSIVE "), "last line: {last:?}");
+    let (coarse, full) = (field(last, "coarse_ms"), field(last, "full_ms"));
+    assert!(coarse > 0.0 && coarse <= full, "{last}");
+}
+
+#[test]
+fn bench_of_a_missing_scene_fails_with_its_name() {
+    let d = quad_scene("missing");
+    let o = tracelab(&["bench", "nope.txt"], &d);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nope.txt"));
+}
