@@ -232,8 +232,8 @@ impl CompiledScene {
             Shape::Triangle { normal, .. } => *normal,
             Shape::Mesh(m) => m.face_normal(hit.prim),
             Shape::Box { .. } => box_face_normal(hit.prim),
-            // CSG leaves have their own transforms: see `world_normal`.
-            Shape::Csg(_) => Vec3::Z,
+            // In the space of the operand hit: CSG leaves have their own transforms.
+            Shape::Csg(tree) => tree.object_normal(ray, hit.t, hit.prim),
         }
     }
 

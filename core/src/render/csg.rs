@@ -225,21 +225,28 @@ impl CsgTree {
         }
     }
 
-    /// The world normal of a hit with this code, normalised, by the chosen rule; flipped for
-    /// B's surfaces exposed by a subtraction.
-    pub fn world_normal(&self, ray: &Ray, t: f32, code: u32, mode: NormalTransform) -> Vec3 {
+    /// The normal of a hit with this code in its leaf's object space, unit length, flipped
+    /// for B's surfaces exposed by a subtraction.
+    pub fn object_normal(&self, ray: &Ray, t: f32, code: u32) -> Vec3 {
         let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
         let r = match &leaf.xf {
             Some(xf) => ray.transformed(&xf.object_from_world),
             None => *ray,
         };
         let n = leaf_normal(&leaf.solid, &r, t, code & EXIT_BIT != 0);
-        let n = match (&leaf.xf, mode) {
+        if code & FLIP_BIT != 0 { -n } else { n }
+    }
+
+    /// The world normal of a hit with this code, normalised, by the chosen rule (flipped as
+    /// `object_normal` is: the flip commutes with either linear map).
+    pub fn world_normal(&self, ray: &Ray, t: f32, code: u32, mode: NormalTransform) -> Vec3 {
+        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
+        let n = self.object_normal(ray, t, code);
+        match (&leaf.xf, mode) {
             (None, _) => n,
             (Some(xf), NormalTransform::Correct) => (xf.normal_from_object * n).normalize_or(n),
             (Some(xf), NormalTransform::Incorrect) => xf.world_from_object.transform_vector3(n).normalize_or(n),
-        };
-        if code & FLIP_BIT != 0 { -n } else { n }
+        }
     }
 
     pub fn leaf(&self, code: u32) -> Option<&CsgLeaf> {

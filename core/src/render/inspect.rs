@@ -100,7 +100,12 @@ pub fn inspect_pixel(
             let normal_correct = compiled.world_normal(&world_ray, &hit, NormalTransform::Correct);
             let normal_incorrect =
                 compiled.world_normal(&world_ray, &hit, NormalTransform::Incorrect);
-            let cos = normal_correct.dot(normal_incorrect).clamp(-1.0, 1.0);
+            // atan2 of sine and cosine: acos of a dot product near 1 turns rounding into
+            // hundredths of a degree where the rules agree exactly.
+            let angle = normal_correct
+                .cross(normal_incorrect)
+                .length()
+                .atan2(normal_correct.dot(normal_incorrect));
             Some(HitStory {
                 node,
                 path,
@@ -111,7 +116,7 @@ pub fn inspect_pixel(
                 object_normal,
                 normal_correct,
                 normal_incorrect,
-                normal_angle_degrees: cos.acos().to_degrees(),
+                normal_angle_degrees: angle.to_degrees(),
                 shade: shade_hit(compiled, &world_ray, &hit, settings),
             })
         });
@@ -243,8 +248,11 @@ Group { numObjects 1
         assert_eq!(kinds, ["Group", "Subtraction", "Transform", "Sphere"]);
         assert_eq!(frame.get(22, 18).expect("in frame").node, h.node.0);
         assert_eq!(h.shade.diffuse, Vec3::new(0.0, 0.0, 1.0));
-        // The exposed inner surface faces the viewer.
+        // The exposed inner surface faces the viewer; the object normal is the sphere's, in
+        // its own (unscaled) space, flipped inward.
         assert!(h.normal_correct.z > 0.0, "{:?}", h.normal_correct);
+        let radial = (h.object_point - Vec3::ZERO).normalize();
+        assert!((h.object_normal + radial).length() < 1e-4, "{:?} vs {radial:?}", h.object_normal);
         let px = frame.get(22, 18).expect("in frame");
         let e = story.color();
         assert_eq!(px.color, [quantize(e.x), quantize(e.y), quantize(e.z)]);
