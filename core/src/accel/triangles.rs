@@ -2,7 +2,7 @@
 //! 8-wide nodes, with the triangles stored in leaf order as (v0, e1, e2) so a leaf test reads
 //! contiguous memory and skips two subtractions per triangle.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 use super::sah::{self, PrimRef};
@@ -46,6 +46,10 @@ pub struct TriangleBvh {
     /// Triangles in leaf order; `ids[i]` is the mesh's index of `tris[i]`.
     tris: Vec<Tri>,
     ids: Vec<u32>,
+    /// The root's box, tested alone before the traversal sets up: most rays of a scene's
+    /// frame miss the mesh, and one box is far cheaper than the root's eight.
+    root_lo: Vec3A,
+    root_hi: Vec3A,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,6 +69,18 @@ struct RayPre {
 }
 
 impl RayPre {
+    /// Whether the ray meets the box [lo, hi] within [t_min, t_max], widened as `slab8`
+    /// widens so it never culls a box the traversal would enter.
+    #[inline(always)]
+    fn enters(&self, lo: Vec3A, hi: Vec3A, t_min: f32, t_max: f32) -> bool {
+        let (o, inv) = (Vec3A::from(self.o), Vec3A::from(self.inv));
+        let (t0, t1) = ((lo - o) * inv, (hi - o) * inv);
+        // maxps/minps return the second operand for a NaN lane (0 * inf): that axis drops out.
+        let near = t0.min(t1).max(Vec3A::splat(t_min)).max_element();
+        let far = t0.max(t1).min(Vec3A::splat(t_max)).min_element();
+        near <= far * 1.000_000_4
+    }
+
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
         // One packed division rather than three scalar ones on every ray's critical path.
@@ -126,6 +142,9 @@ macro_rules! closest_hit {
             return None;
         }
         let r = RayPre::new(ray);
+        if !r.enters($self.root_lo, $self.root_hi, t_min, t_max) {
+            return None;
+        }
         let mut t_best = t_max;
         let mut best = usize::MAX;
         let mut stack = RayStack::new();
@@ -244,7 +263,18 @@ impl TriangleBvh {
             },
             move || drop(root),
         );
-        TriangleBvh { nodes, tris, ids }
+        let root = nodes.first().map_or(Aabb::EMPTY, |r| {
+            (0..WIDTH)
+                .filter(|&i| !r.slot_is_empty(i))
+                .fold(Aabb::EMPTY, |b, i| b.union(r.slot_bounds(i)))
+        });
+        TriangleBvh {
+            nodes,
+            tris,
+            ids,
+            root_lo: root.min.into(),
+            root_hi: root.max.into(),
+        }
     }
 
     pub fn bounds(&self) -> Aabb {
