@@ -44,10 +44,9 @@ impl Tri {
 pub struct TriangleBvh {
     nodes: Vec<Node8>,
     /// Triangles in leaf order, one array per component (v0.x, v0.y, v0.z, e1.x, ... e2.z,
-    /// each `stride` long), so a leaf's up to eight triangles load as one 8-lane vector per
-    /// component. `stride` is the triangle count plus 8 (zeros: det = 0, never a hit), so
-    /// the 8-lane loads of a leaf near the end stay inside. `ids[i]` is the mesh's index of
-    /// triangle i.
+    /// each `stride` = triangle count long), so a leaf's up to eight triangles load as one
+    /// 8-lane vector per component; lanes past the leaf (the next component's values, or 7
+    /// zeros at the very end) are masked off. `ids[i]` is the mesh's index of triangle i.
     soa: Vec<f32>,
     stride: usize,
     ids: Vec<u32>,
@@ -262,8 +261,8 @@ impl TriangleBvh {
                 .filter(|&i| !r.slot_is_empty(i))
                 .fold(Aabb::EMPTY, |b, i| b.union(r.slot_bounds(i)))
         });
-        let stride = tris.len() + WIDTH;
-        let mut soa = vec![0.0f32; 9 * stride];
+        let stride = tris.len();
+        let mut soa = vec![0.0f32; 9 * stride + WIDTH - 1];
         for (i, t) in tris.iter().enumerate() {
             for (k, v) in [t.v0, t.e1, t.e2].iter().enumerate() {
                 soa[(3 * k) * stride + i] = v.x;
@@ -312,8 +311,8 @@ impl TriangleBvh {
                 Err("nodes or triangles for an empty mesh".into())
             };
         }
-        if self.stride != triangles.len() + WIDTH
-            || self.soa.len() != 9 * self.stride
+        if self.stride != triangles.len()
+            || self.soa.len() != 9 * self.stride + WIDTH - 1
             || self.ids.len() != triangles.len()
         {
             return Err(format!(
