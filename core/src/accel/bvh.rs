@@ -24,8 +24,10 @@ impl BvhNode {
     fn hit(&self, o: Vec3A, inv: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
         let t0 = (Vec3A::from(self.min) - o) * inv;
         let t1 = (Vec3A::from(self.max) - o) * inv;
-        let near = t0.min(t1).max_element().max(t_min);
-        let far = t0.max(t1).min_element().min(t_max);
+        // Packed clamps: maxps/minps return the second operand for a NaN lane (0 * inf), so
+        // that axis drops out, without the scalar NaN checks of f32::max.
+        let near = t0.min(t1).max(Vec3A::splat(t_min)).max_element();
+        let far = t0.max(t1).min(Vec3A::splat(t_max)).min_element();
         (near <= far).then_some(near)
     }
 

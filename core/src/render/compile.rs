@@ -76,6 +76,10 @@ pub struct CompiledScene {
     bvh: Bvh,
     /// Objects with no finite bounds (planes), tested for every ray.
     unbounded: Vec<u32>,
+    /// The one object of a scene that holds a single mesh and nothing else: rays go straight
+    /// to it, since the mesh tests its own box first (in object space, needing no second
+    /// reciprocal of the direction).
+    single_mesh: Option<u32>,
 }
 
 impl CompiledScene {
@@ -150,6 +154,11 @@ impl CompiledScene {
             *p = bounded_ids[*p as usize];
         }
 
+        let single_mesh = match (bvh.indices.as_slice(), unbounded.is_empty()) {
+            (&[i], true) => matches!(objects[i as usize].shape, Shape::Mesh(_)).then_some(i),
+            _ => None,
+        };
+
         let lights = scene
             .lights()
             .iter()
@@ -164,11 +173,15 @@ impl CompiledScene {
             objects,
             bvh,
             unbounded,
+            single_mesh,
         }
     }
 
     /// The closest hit with t in (t_min, t_max).
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
+        if let Some(i) = self.single_mesh {
+            return self.intersect_object(i, ray, t_min, t_max).map(|(t, prim)| Hit { t, object: i, prim });
+        }
         let mut best: Option<Hit> = None;
         let mut t_best = t_max;
         for &i in &self.unbounded {
