@@ -15,6 +15,9 @@ use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, Share
 #[derive(Clone, Debug)]
 pub struct Job {
     pub generation: u64,
+    /// Counts requests: a view change (size, normal rule) renders the same generation
+    /// again, and only this tells the two renders apart.
+    pub request: u64,
     pub scene: Arc<Scene>,
     pub settings: RenderSettings,
     pub modes: Vec<NormalTransform>,
@@ -47,6 +50,7 @@ pub struct RenderWorker {
     shared: Arc<Shared>,
     thread: Option<std::thread::JoinHandle<()>>,
     last_generation: u64,
+    requests: u64,
     last_key: Option<(u32, u32, bool, Vec<NormalTransform>)>,
 }
 
@@ -71,6 +75,7 @@ impl RenderWorker {
             shared,
             thread,
             last_generation: 0,
+            requests: 0,
             last_key: None,
         }
     }
@@ -107,8 +112,10 @@ impl RenderWorker {
         // Stop the render in flight within a tile; the next job gets a fresh flag.
         self.cancel.store(true, Ordering::Relaxed);
         self.cancel = Arc::new(AtomicBool::new(false));
+        self.requests += 1;
         let job = Job {
             generation,
+            request: self.requests,
             scene: scene(),
             settings,
             modes,
@@ -133,7 +140,7 @@ impl RenderWorker {
     /// Whether the newest request has been fully rendered.
     pub fn is_idle(&self) -> bool {
         self.with_published(|p| {
-            p.is_some_and(|p| p.job.generation == self.last_generation && p.full.is_some())
+            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some())
         })
     }
 
@@ -202,7 +209,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 .published
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner);
-            if let Some(p) = p.as_mut().filter(|p| p.job.generation == job.generation) {
+            if let Some(p) = p.as_mut().filter(|p| p.job.request == job.request) {
                 p.passes = passes;
                 if least > p.passes_done {
                     p.passes_done = least;
@@ -325,5 +332,23 @@ mod tests {
         ));
         wait_idle(&w);
         w.with_published(|p| assert_eq!(p.expect("published").frames.len(), 2));
+    }
+
+    #[test]
+    fn a_new_rule_at_the_same_generation_is_not_idle_until_it_is_rendered() {
+        // A view change keeps the document's generation; the finished render of the old
+        // rule must not count as the new one being done (the GUI test of the normal switch
+        // once read the old image this way).
+        let mut w = RenderWorker::new();
+        let s = scene();
+        let settings = RenderSettings::new(400, 400);
+        assert!(w.request(7, || s.clone(), settings, vec![NormalTransform::Correct]));
+        wait_idle(&w);
+        assert!(w.request(7, || s.clone(), settings, vec![NormalTransform::Incorrect]));
+        assert!(!w.is_idle(), "idle before the Incorrect render ran");
+        wait_idle(&w);
+        w.with_published(|p| {
+            assert_eq!(p.expect("published").job.modes, [NormalTransform::Incorrect]);
+        });
     }
 }
