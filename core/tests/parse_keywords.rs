@@ -57,7 +57,7 @@ fn every_keyword_reads_into_the_scene() {
     assert_eq!(kids.len(), 5);
     let kinds: Vec<&str> = kids.iter().map(|&c| g.node(c).kind.name()).collect();
     assert_eq!(kinds, ["Sphere", "Plane", "Triangle", "TriangleMesh", "Transform"]);
-    let mats: Vec<Option<u32>> = g.effective_materials().iter().copied().collect();
+    let mats: Vec<Option<u32>> = g.effective_materials().to_vec();
     assert_eq!(kids.iter().map(|c| mats[c.index()]).collect::<Vec<_>>(), [Some(0), Some(0), Some(1), Some(1), Some(1)]);
     match &g.node(kids[3]).kind {
         NodeKind::TriangleMesh { mesh, .. } => assert_eq!(mesh.mesh().map(|m| m.triangle_count()), Some(12)),

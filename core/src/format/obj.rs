@@ -53,10 +53,10 @@ impl MeshCache {
         let canon = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
         let meta = std::fs::metadata(&canon).map_err(|e| e.to_string())?;
         let stamp = (meta.modified().ok(), meta.len());
-        if let Some((t, len, m)) = self.meshes.get(&canon) {
-            if (*t, *len) == stamp {
-                return Ok(m.clone());
-            }
+        if let Some((t, len, m)) = self.meshes.get(&canon)
+            && (*t, *len) == stamp
+        {
+            return Ok(m.clone());
         }
         let mesh = Arc::new(load_obj(&canon)?);
         self.meshes.insert(canon, (stamp.0, stamp.1, mesh.clone()));

@@ -133,13 +133,14 @@ fn write_graph(out: &mut String, graph: &Graph) {
         let mut closers = Vec::new();
         // A material set on a node outside a Group's list cannot be written as MaterialIndex
         // there; wrap the node in a one-object Group that sets it.
-        if !in_group && id != graph.root() {
-            if let Some(m) = node.material {
-                let ind = indent(depth);
-                let _ = writeln!(out, "{ind}Group {{\n{ind}{IND}numObjects 1\n{ind}{IND}MaterialIndex {m}");
-                closers.push(format!("{ind}}}\n"));
-                depth += 1;
-            }
+        if !in_group
+            && id != graph.root()
+            && let Some(m) = node.material
+        {
+            let ind = indent(depth);
+            let _ = writeln!(out, "{ind}Group {{\n{ind}{IND}numObjects 1\n{ind}{IND}MaterialIndex {m}");
+            closers.push(format!("{ind}}}\n"));
+            depth += 1;
         }
         let ind = indent(depth);
         let inner = format!("{ind}{IND}");
@@ -156,11 +157,11 @@ fn write_graph(out: &mut String, graph: &Graph) {
                 let mut work = Vec::new();
                 for &c in &node.children {
                     let want = graph.get(c).and_then(|n| n.material);
-                    if let Some(m) = want {
-                        if current != Some(m) {
-                            work.push(Work::Text(format!("{inner}MaterialIndex {m}\n")));
-                            current = Some(m);
-                        }
+                    if let Some(m) = want
+                        && current != Some(m)
+                    {
+                        work.push(Work::Text(format!("{inner}MaterialIndex {m}\n")));
+                        current = Some(m);
                     }
                     work.push(Work::Open { id: c, depth: depth + 1, in_group: true });
                 }

@@ -163,10 +163,11 @@ fn render_scales(
             for row in (y0..y1).step_by(scale as usize) {
                 for x in (x0..x1).step_by(scale as usize) {
                     // Already traced by a coarser pass.
-                    if let Some(c) = coarser {
-                        if x % c == 0 && row % c == 0 {
-                            continue;
-                        }
+                    if let Some(c) = coarser
+                        && x % c == 0
+                        && row % c == 0
+                    {
+                        continue;
                     }
                     local.push((x, row, trace_sample(scene, settings, x, row)));
                 }
