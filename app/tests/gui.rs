@@ -11,6 +11,9 @@ use tracelab::app::{AppOptions, Pending, TracelabApp};
 use tracelab::state::Selection;
 use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
 
+mod common;
+use common::skip_note;
+
 fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
 }
@@ -24,7 +27,7 @@ fn shared_scene(name: &str) -> Option<PathBuf> {
         std::env::var_os("TRACELAB_REQUIRE_SHARED").is_none(),
         "../shared/mit6837 is required here"
     );
-    eprintln!("SKIPPED: {} is not there (../shared absent)", p.display());
+    skip_note(&format!("SKIPPED: {} is not there (../shared absent)", p.display()));
     None
 }
 

@@ -8,13 +8,16 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use tracelab::app::{AppOptions, TracelabApp};
 
+mod common;
+use common::skip_note;
+
 /// Snapshots are only comparable on the pinned backend (lavapipe via Vulkan): other
 /// backends differ in a few pixels. `.ci/run` pins it; elsewhere these tests skip, saying so.
 fn pinned_backend() -> bool {
     let ok = std::env::var("WGPU_BACKEND").is_ok_and(|b| b == "vulkan");
     if !ok {
-        eprintln!(
-            "SKIPPED: set WGPU_BACKEND=vulkan and VK_DRIVER_FILES to lavapipe (see .ci/run) to compare snapshots"
+        skip_note(
+            "SKIPPED: set WGPU_BACKEND=vulkan and VK_DRIVER_FILES to lavapipe (see .ci/run) to compare snapshots",
         );
     }
     ok

@@ -937,10 +937,10 @@ mod tests {
                 "{} is required here",
                 dir.display()
             );
-            eprintln!(
+            crate::test_support::skip_note(&format!(
                 "SKIPPED: {} not found; shared meshes not checked",
                 dir.display()
-            );
+            ));
             return;
         }
         // The dragon is left to the benchmark's checksums: brute force over 871k triangles

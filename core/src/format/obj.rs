@@ -259,7 +259,7 @@ mod tests {
                 "{} missing",
                 dir.display()
             );
-            eprintln!("SKIPPED: {} not found", dir.display());
+            crate::test_support::skip_note(&format!("SKIPPED: {} not found", dir.display()));
             return;
         }
         // The dragon takes tobj seconds in a debug build; the smaller meshes cover the format.
