@@ -45,7 +45,7 @@ fn compare(out: &Path, reference: &Path) -> Result<(f64, u8), String> {
 fn every_course_command_line_matches_the_reference_images() {
     let Some(shared) = shared() else {
         assert!(std::env::var_os("TRACELAB_REQUIRE_SHARED").is_none(), "../shared/mit6837 is required here");
-        skip_note(&format!("SKIPPED: ../shared/mit6837 not found; conformance not checked"));
+        skip_note("SKIPPED: ../shared/mit6837 not found; conformance not checked");
         return;
     };
     let dir = std::env::temp_dir().join(format!("tracelab-conformance-{}", std::process::id()));
