@@ -5,5 +5,5 @@ mod primitives;
 mod ray;
 
 pub use aabb::Aabb;
-pub use primitives::{intersect_plane, intersect_sphere, intersect_triangle, triangle_normal};
+pub use primitives::{intersect_plane, intersect_sphere, intersect_triangle, sphere_roots, triangle_normal};
 pub use ray::Ray;

@@ -5,9 +5,11 @@ use glam::Vec3;
 
 use super::Ray;
 
-/// Smallest root of |o + t d − c|² = r² in (t_min, t_max). Works for unnormalised d.
+/// Both roots of |o + t d − c|² = r², the smaller first. Works for unnormalised d. CSG
+/// takes both (entry and exit); `intersect_sphere` the first in range, so a CSG sphere and a
+/// plain one meet a ray at the same t to the last bit.
 #[inline]
-pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max: f32) -> Option<f32> {
+pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
     let oc = ray.origin - center;
     let a = ray.direction.length_squared();
     let half_b = oc.dot(ray.direction);
@@ -19,10 +21,14 @@ pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max:
     let sq = disc.sqrt();
     // Numerically stable pair of roots.
     let q = -half_b - sq.copysign(half_b);
-    let (mut t0, mut t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
-    if t0 > t1 {
-        std::mem::swap(&mut t0, &mut t1);
-    }
+    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+}
+
+/// Smallest root of |o + t d − c|² = r² in (t_min, t_max).
+#[inline]
+pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max: f32) -> Option<f32> {
+    let (t0, t1) = sphere_roots(ray, center, radius)?;
     if t0 > t_min && t0 < t_max {
         Some(t0)
     } else if t1 > t_min && t1 < t_max {

@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 use super::NormalTransform;
 use super::compile::Xf;
 use crate::accel::TriangleHit;
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::{Aabb, Ray, sphere_roots};
 use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, compose};
 
 /// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low
@@ -289,24 +289,6 @@ fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
         Some(xf) => local.transformed(&xf.world_from_object),
         None => local,
     }
-}
-
-/// Both roots of |o + t d − c|² = r², the smaller first, computed exactly as
-/// `geometry::intersect_sphere` does, so a CSG sphere and a plain one meet a ray at the
-/// same t to the last bit.
-pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
-    let oc = ray.origin - center;
-    let a = ray.direction.length_squared();
-    let half_b = oc.dot(ray.direction);
-    let c = oc.length_squared() - radius * radius;
-    let disc = half_b * half_b - a * c;
-    if disc < 0.0 || a == 0.0 {
-        return None;
-    }
-    let sq = disc.sqrt();
-    let q = -half_b - sq.copysign(half_b);
-    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
-    Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
 }
 
 /// A box face: axis · 2 + 1 for the max side. Its outward normal is `box_face_normal`.
