@@ -14,6 +14,7 @@ use super::compile::CompiledScene;
 use super::frame::{Frame, Sample, sample_from};
 use super::shade::shade_fast;
 use super::RenderSettings;
+use crate::geometry::Ray;
 
 const TILE: u32 = 64;
 const SCALES: [u32; 4] = [8, 4, 2, 1];
@@ -75,10 +76,9 @@ pub struct PassInfo {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cancelled;
 
-/// Traces one pixel (rows from the top) and shades it.
+/// Traces one pixel's ray and shades it.
 #[inline]
-fn trace_sample(scene: &CompiledScene, s: &RenderSettings, x: u32, row: u32) -> Sample {
-    let ray = scene.camera.pixel_ray(x, row, s.width, s.height);
+fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray) -> Sample {
     match scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY) {
         Some(hit) => {
             let (c, n) = shade_fast(scene, &ray, &hit, s);
@@ -144,6 +144,8 @@ fn render_scales(
     if w == 0 || h == 0 {
         return Ok(());
     }
+    // The columns' share of every camera ray, once per render rather than per pixel.
+    let rays = scene.camera.pixel_rays(w, h);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
@@ -161,6 +163,7 @@ fn render_scales(
             let y1 = (y0 + TILE).min(h);
             let mut local: Vec<(u32, u32, Sample)> = Vec::new();
             for row in (y0..y1).step_by(scale as usize) {
+                let row_rays = rays.row(row);
                 for x in (x0..x1).step_by(scale as usize) {
                     // Already traced by a coarser pass.
                     if let Some(c) = coarser
@@ -169,7 +172,7 @@ fn render_scales(
                     {
                         continue;
                     }
-                    local.push((x, row, trace_sample(scene, settings, x, row)));
+                    local.push((x, row, trace_sample(scene, settings, row_rays.ray(x))));
                 }
             }
             let mut f = target.lock();
