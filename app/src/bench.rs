@@ -37,6 +37,9 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
     for m in &meshes {
         std::hint::black_box(TriangleBvh::build(&m.positions, &m.triangles));
     }
+    for m in &meshes {
+        println!("bvh: {}", m.accel.shape());
+    }
     let compiled = CompiledScene::new(&scene);
     let build_ms = t_build.elapsed().as_secs_f64() * 1e3;
 

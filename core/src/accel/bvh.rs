@@ -54,7 +54,7 @@ impl Bvh {
             .enumerate()
             .map(|(i, b)| PrimRef::new(*b, i as u32))
             .collect();
-        let Some(root) = sah::build(&mut prims) else {
+        let Some(root) = sah::build(&mut prims, sah::LeafBlock(1)) else {
             return Bvh::default();
         };
         let mut nodes = Vec::new();

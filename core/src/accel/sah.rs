@@ -20,8 +20,23 @@ pub const MAX_DEPTH: usize = 64;
 const PARALLEL_SUBTREE: usize = 4096;
 /// Above this many primitives a node's binning pass is itself split across threads.
 const PARALLEL_BINNING: usize = 1 << 16;
-/// Cost of one node visit relative to one primitive test, in the SAH.
+/// Cost of one node visit relative to one leaf test, in the SAH.
 const TRAVERSAL_COST: f32 = 1.0;
+
+/// How many primitives a leaf tests at once: the SAH charges a leaf by the block, so with
+/// blocks of 8 (the mesh BVH's AVX leaf test) a leaf of 7 costs what a leaf of 1 does.
+/// Measured against charging per primitive (1 thread, 800x800, medians of 7, same minute):
+/// Stanford bunny 10.4 -> 11.5 Mrays/s, dragon 9.2 -> 10.3, bunny_1k 16.8 -> 17.6, cube
+/// unchanged; memory 98 -> 70 bytes/triangle (leaves of 1.85 -> 7.3 triangles).
+#[derive(Clone, Copy, Debug)]
+pub struct LeafBlock(pub u32);
+
+impl LeafBlock {
+    #[inline]
+    fn cost(self, n: u32) -> f32 {
+        n.div_ceil(self.0.max(1)) as f32
+    }
+}
 
 /// A primitive's box and its index in the caller's order (32 bytes).
 #[derive(Clone, Copy, Debug)]
@@ -71,12 +86,12 @@ impl Node {
 }
 
 /// Builds over `prims`, reordering them so every leaf is a contiguous range. `None` when empty.
-pub fn build(prims: &mut [PrimRef]) -> Option<Node> {
+pub fn build(prims: &mut [PrimRef], block: LeafBlock) -> Option<Node> {
     if prims.is_empty() {
         return None;
     }
     let (bounds, cb) = extents(prims);
-    Some(build_rec(prims, 0, bounds, cb, 0))
+    Some(build_rec(prims, 0, bounds, cb, 0, block))
 }
 
 /// (union of boxes, box of the doubled centroids).
@@ -160,7 +175,14 @@ impl Binner {
     }
 }
 
-fn build_rec(prims: &mut [PrimRef], first: usize, bounds: Aabb, cb: Aabb, depth: usize) -> Node {
+fn build_rec(
+    prims: &mut [PrimRef],
+    first: usize,
+    bounds: Aabb,
+    cb: Aabb,
+    depth: usize,
+    block: LeafBlock,
+) -> Node {
     let n = prims.len();
     let leaf = Node::Leaf {
         bounds,
@@ -196,34 +218,47 @@ fn build_rec(prims: &mut [PrimRef], first: usize, bounds: Aabb, cb: Aabb, depth:
             binner.fill(prims, &mut b);
             b
         };
-        let Some((cost, axis, split)) = best_split(&bins, binner.count, &ext) else {
+        let Some((cost, axis, split)) = best_split(&bins, binner.count, &ext, block) else {
             return if n <= MAX_LEAF {
                 leaf
             } else {
-                split_middle(prims, first, bounds, depth)
+                split_middle(prims, first, bounds, depth, block)
             };
         };
         let area = bounds.surface_area();
-        if n <= MAX_LEAF && cost + TRAVERSAL_COST * area >= n as f32 * area {
+        if n <= MAX_LEAF && cost + TRAVERSAL_COST * area >= block.cost(n as u32) * area {
             return leaf;
         }
         partition(prims, |p| binner.bin(p.c2(), axis) <= split)
     };
     let mid = if mid == 0 || mid == n { n / 2 } else { mid };
-    children(prims, first, bounds, mid, depth)
+    children(prims, first, bounds, mid, depth, block)
 }
 
-fn split_middle(prims: &mut [PrimRef], first: usize, bounds: Aabb, depth: usize) -> Node {
+fn split_middle(
+    prims: &mut [PrimRef],
+    first: usize,
+    bounds: Aabb,
+    depth: usize,
+    block: LeafBlock,
+) -> Node {
     let mid = prims.len() / 2;
-    children(prims, first, bounds, mid, depth)
+    children(prims, first, bounds, mid, depth, block)
 }
 
-fn children(prims: &mut [PrimRef], first: usize, bounds: Aabb, mid: usize, depth: usize) -> Node {
+fn children(
+    prims: &mut [PrimRef],
+    first: usize,
+    bounds: Aabb,
+    mid: usize,
+    depth: usize,
+    block: LeafBlock,
+) -> Node {
     let n = prims.len();
     let (l, r) = prims.split_at_mut(mid);
     let sub = |s: &mut [PrimRef], f: usize| {
         let (b, c) = extents(s);
-        build_rec(s, f, b, c, depth + 1)
+        build_rec(s, f, b, c, depth + 1, block)
     };
     let (left, right) = if n > PARALLEL_SUBTREE {
         rayon::join(|| sub(l, first), || sub(r, first + mid))
@@ -237,7 +272,7 @@ fn children(prims: &mut [PrimRef], first: usize, bounds: Aabb, mid: usize, depth
 }
 
 /// The cheapest split over all axes: (SAH cost, axis, last bin on the left).
-fn best_split(bins: &Bins, nb: usize, ext: &Vec3) -> Option<(f32, usize, usize)> {
+fn best_split(bins: &Bins, nb: usize, ext: &Vec3, block: LeafBlock) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for a in 0..3 {
         if ext[a].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
@@ -249,7 +284,7 @@ fn best_split(bins: &Bins, nb: usize, ext: &Vec3) -> Option<(f32, usize, usize)>
         for i in (1..nb).rev() {
             acc = acc.union(bins.boxes[a][i]);
             cnt += bins.counts[a][i];
-            right_cost[i] = acc.surface_area() * cnt as f32;
+            right_cost[i] = acc.surface_area() * block.cost(cnt);
             right_count[i] = cnt;
         }
         let (mut acc, mut cnt) = (Aabb::EMPTY, 0u32);
@@ -259,7 +294,7 @@ fn best_split(bins: &Bins, nb: usize, ext: &Vec3) -> Option<(f32, usize, usize)>
             if cnt == 0 || right_count[i + 1] == 0 {
                 continue;
             }
-            let cost = acc.surface_area() * cnt as f32 + right_cost[i + 1];
+            let cost = acc.surface_area() * block.cost(cnt) + right_cost[i + 1];
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, a, i));
             }

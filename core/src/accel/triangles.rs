@@ -230,7 +230,7 @@ impl TriangleBvh {
                 PrimRef::new(Aabb::new(a.min(b).min(c), a.max(b).max(c)), i as u32)
             })
             .collect();
-        let Some(root) = sah::build(&mut prims) else {
+        let Some(root) = sah::build(&mut prims, sah::LeafBlock(WIDTH as u32)) else {
             return TriangleBvh::default();
         };
         let nodes = wide::collapse(&root);
@@ -292,6 +292,28 @@ impl TriangleBvh {
     /// Bytes held by the nodes and the triangle copies.
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node8>() + self.soa.len() * 4 + self.ids.len() * 4
+    }
+
+    /// Shape of the tree, for `tracelab bench`: nodes, mean children per node, leaves and
+    /// mean triangles per leaf.
+    pub fn shape(&self) -> String {
+        let (mut slots, mut leaves) = (0usize, 0usize);
+        for n in &self.nodes {
+            for s in 0..WIDTH {
+                if !n.slot_is_empty(s) {
+                    slots += 1;
+                    leaves += wide::is_leaf(n.child[s]) as usize;
+                }
+            }
+        }
+        let per = |a: usize, b: usize| a as f64 / b.max(1) as f64;
+        format!(
+            "{} nodes, {:.2} children/node, {} leaves, {:.2} triangles/leaf",
+            self.nodes.len(),
+            per(slots, self.nodes.len()),
+            leaves,
+            per(self.ids.len(), leaves)
+        )
     }
 
     /// Checks the BVH invariants against the mesh it was built from (for tests): every
