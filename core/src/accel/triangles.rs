@@ -472,8 +472,22 @@ impl TriangleBvh {
 
     /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
     #[inline(always)]
-    fn intersect_portable(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
-        closest_hit!(self, o, d, t_min, t_max, RayPre::slab8, TriangleBvh::leaf_scalar)
+    fn intersect_portable(
+        &self,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        closest_hit!(
+            self,
+            o,
+            d,
+            t_min,
+            t_max,
+            RayPre::slab8,
+            TriangleBvh::leaf_scalar
+        )
     }
 
     /// Triangle `i` (leaf order) from the component arrays; zeros past the end.
