@@ -100,6 +100,13 @@ impl PixelRays {
 }
 
 impl RowRays<'_> {
+    /// All rays of the row into `out` (cleared first), in one tight loop: with no traversal
+    /// between them, each ray's square root and division overlap the next ray's.
+    pub fn fill(&self, out: &mut Vec<Ray>) {
+        out.clear();
+        out.extend((0..self.columns.len() as u32).map(|i| self.ray(i)));
+    }
+
     /// The ray through pixel `i` of this row (`pixel_ray`'s, bit for bit); the origin for i
     /// past the width.
     #[inline]
@@ -175,10 +182,14 @@ mod tests {
             let c = CameraRays::new(cam);
             for (w, h) in [(1, 1), (7, 3), (3, 7), (800, 800), (640, 480)] {
                 let rays = c.pixel_rays(w, h);
+                let mut filled = Vec::new();
                 for row in 0..h {
                     let r = rays.row(row);
+                    r.fill(&mut filled);
+                    assert_eq!(filled.len(), w as usize);
                     for i in 0..w {
                         assert_eq!(r.ray(i), c.pixel_ray(i, row, w, h), "{w}x{h} pixel ({i}, {row})");
+                        assert_eq!(filled[i as usize], r.ray(i), "fill, {w}x{h} pixel ({i}, {row})");
                     }
                 }
             }
