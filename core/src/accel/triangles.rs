@@ -224,6 +224,17 @@ impl TriangleBvh {
     /// Builds over the mesh. Vertex indices out of range read as the origin (the loaders
     /// reject them); triangles beyond 2^28 are left out.
     pub fn build(positions: &[Vec3], triangles: &[[u32; 3]]) -> TriangleBvh {
+        // Leaves sized for the leaf test this CPU runs: eight triangles cost one AVX test,
+        // but eight scalar tests where there is no AVX.
+        let block = if has_avx() { WIDTH as u32 } else { 1 };
+        Self::build_with(positions, triangles, sah::LeafBlock(block))
+    }
+
+    fn build_with(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        block: sah::LeafBlock,
+    ) -> TriangleBvh {
         let triangles = &triangles[..triangles.len().min(wide::MAX_TRIANGLES)];
         let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
         let mut prims: Vec<PrimRef> = triangles
@@ -235,7 +246,7 @@ impl TriangleBvh {
                 PrimRef::new(Aabb::new(a.min(b).min(c), a.max(b).max(c)), i as u32)
             })
             .collect();
-        let Some(root) = sah::build(&mut prims, sah::LeafBlock(WIDTH as u32)) else {
+        let Some(root) = sah::build(&mut prims, block) else {
             return TriangleBvh::default();
         };
         let nodes = wide::collapse(&root);
@@ -462,7 +473,7 @@ impl TriangleBvh {
     #[inline]
     pub fn closest_hit(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
+        if has_avx() {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX, checked just above (std caches the answer).
             return unsafe { self.intersect_avx(o, d, t_min, t_max) };
@@ -533,6 +544,15 @@ impl TriangleBvh {
     fn intersect_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         closest_hit!(self, o, d, t_min, t_max, slab8_avx, leaf8_avx)
     }
+}
+
+/// Whether the AVX traversal and leaf test run here.
+#[inline(always)]
+fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 /// `TriangleBvh::leaf_scalar` for a whole leaf at once: the same Möller–Trumbore steps in
@@ -806,6 +826,35 @@ mod tests {
                 &rays_toward(Vec3::ZERO, 2.0, 2000, 99 + seed),
             );
         }
+    }
+
+    /// Both leaf sizings (the AVX one and the one for CPUs without it) build valid trees that
+    /// find the brute-force hits; the AVX sizing makes leaves of several triangles.
+    #[test]
+    fn both_leaf_sizings_build_valid_trees() {
+        let (pos, tris) = random_mesh(5000, 23);
+        let mut per_leaf = Vec::new();
+        for block in [1, WIDTH as u32] {
+            let bvh = TriangleBvh::build_with(&pos, &tris, sah::LeafBlock(block));
+            bvh.check_invariants(&pos, &tris)
+                .unwrap_or_else(|e| panic!("block {block}: {e}"));
+            assert_agrees(&pos, &tris, &bvh, &rays_toward(Vec3::ZERO, 2.0, 2000, 5));
+            let leaves: usize = bvh
+                .nodes
+                .iter()
+                .flat_map(|n| {
+                    n.child
+                        .iter()
+                        .enumerate()
+                        .filter(|&(s, c)| !n.slot_is_empty(s) && wide::is_leaf(*c))
+                })
+                .count();
+            per_leaf.push(tris.len() as f64 / leaves as f64);
+        }
+        assert!(
+            per_leaf[1] > 1.5 * per_leaf[0],
+            "triangles per leaf {per_leaf:?}"
+        );
     }
 
     #[test]
