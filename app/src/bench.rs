@@ -60,18 +60,24 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         // One row buffer per rayon job, and jobs of at least 16 rows: with a fresh, growing
         // buffer for every stolen row, 2 threads scaled 1.62-1.78x instead of 1.83-1.95x.
         let new_buf = || Vec::with_capacity(w as usize);
-        buf.par_chunks_mut(w as usize).enumerate().with_min_len(16).for_each_init(new_buf, |row_buf, (row, out)| {
-            // The row's rays first, in one tight loop, then the traversals: made between two
-            // traversals, each ray's square root and division (and then its object-space
-            // transform and reciprocal) headed its own dependency chain. Stanford bunny 12.8 ->
-            // 15.6 Mrays/s, dragon 11.3 -> 13.5, bunny_1k 20.8 -> 29, cube 71 -> 65 (1 thread,
-            // medians of 7, alternating runs). The progressive renderer shades between
-            // traversals, which hides that latency already: the same change gained it nothing.
-            rays.row(row as u32).fill(row_buf);
-            for (ray, t) in row_buf.iter().zip(out.iter_mut()) {
-                *t = compiled.intersect(ray, t_min, f32::INFINITY).map_or(f32::INFINITY, |hit| hit.t);
-            }
-        });
+        buf.par_chunks_mut(w as usize)
+            .enumerate()
+            .with_min_len(16)
+            .for_each_init(new_buf, |row_buf, (row, out)| {
+                // The row's rays first, in one tight loop, then the traversals: made between
+                // two traversals, each ray's square root and division (then its object-space
+                // transform and reciprocal) headed its own dependency chain. Stanford bunny
+                // 12.8 -> 15.6 Mrays/s, dragon 11.3 -> 13.5, bunny_1k 20.8 -> 29, cube 71 -> 65
+                // (1 thread, medians of 7, alternating runs). The progressive renderer shades
+                // between traversals, which hides that latency: the same change gained it
+                // nothing there.
+                rays.row(row as u32).fill(row_buf);
+                for (ray, t) in row_buf.iter().zip(out.iter_mut()) {
+                    *t = compiled
+                        .intersect(ray, t_min, f32::INFINITY)
+                        .map_or(f32::INFINITY, |hit| hit.t);
+                }
+            });
     };
     frame(&mut buf); // warm-up
     let mut times = Vec::with_capacity(b.repeat);

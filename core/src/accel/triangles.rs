@@ -68,7 +68,8 @@ pub struct TriangleHit {
 /// 16-byte `Vec3A`s, not `Vec3`s: the tests below broadcast single components, and with
 /// 12-byte fields LLVM loaded them as 16 bytes spanning two earlier stores, a failed store
 /// forward on every ray (perf put ~20% of the Stanford bunny's traversal samples on the two
-/// loads; measured below).
+/// loads). With `Vec3A`: Stanford bunny 11.5 -> 12.1 Mrays/s, dragon 10.4 -> 10.8, cube 29 ->
+/// 45 (1 thread, medians of 7, alternating runs).
 struct RayPre {
     o: Vec3A,
     d: Vec3A,
