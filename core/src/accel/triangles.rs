@@ -180,7 +180,7 @@ macro_rules! closest_hit {
                         // Two children, the common case below the top: no sort needed.
                         let j = rest.trailing_zeros() as usize;
                         let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
-                        stack.push(n.child[far], tn[far]);
+                        stack.push((n.child[far], tn[far]));
                         cur = n.child[near];
                         continue;
                     }
@@ -190,7 +190,7 @@ macro_rules! closest_hit {
                     while m != 0 {
                         let j = m.trailing_zeros() as usize;
                         m &= m - 1;
-                        stack.push(n.child[j], tn[j]);
+                        stack.push((n.child[j], tn[j]));
                         k += 1;
                     }
                     stack.sort_top(k);
@@ -433,7 +433,7 @@ impl TriangleBvh {
         let r = RayPre::new(ray.origin.into(), ray.direction.into());
         let mut stack = RayStack::new();
         let mut tn = [0.0f32; WIDTH];
-        stack.push(0, t_min);
+        stack.push((0, t_min));
         while let Some((c, _)) = stack.pop() {
             if wide::is_leaf(c) {
                 let (first, count) = wide::leaf_range(c);
@@ -455,7 +455,7 @@ impl TriangleBvh {
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                stack.push(n.child[i], tn[i]);
+                stack.push((n.child[i], tn[i]));
             }
         }
     }
@@ -479,6 +479,182 @@ impl TriangleBvh {
             return unsafe { self.intersect_avx(o, d, t_min, t_max) };
         }
         self.intersect_portable(o, d, t_min, t_max)
+    }
+
+    /// Closest hits of a packet of eight rays (`o[i]`, `d[i]`) in (t_min, t_max[i]), for the
+    /// rays whose bit is set in `active`; a ray that hits has its `t_max` lowered to the hit.
+    /// Each ray gets the t `closest_hit` gives it, bit for bit (the triangle may differ only
+    /// where two are hit at the very same t). Made for coherent rays (a pixel tile's primary
+    /// rays): with AVX, one traversal for the packet, which falls back to single rays when
+    /// the active rays' directions differ in sign on some axis (or one is axis-parallel).
+    pub fn closest_hit8(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above.
+            return unsafe { self.packet_avx(o, d, active, t_min, t_max) };
+        }
+        self.singles8(o, d, active, t_min, t_max)
+    }
+
+    /// `closest_hit8` one ray at a time.
+    fn singles8(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        let mut out = [None; WIDTH];
+        for i in 0..WIDTH {
+            if active & (1 << i) != 0 {
+                out[i] = self.closest_hit(o[i], d[i], t_min, t_max[i]);
+                if let Some(h) = out[i] {
+                    t_max[i] = h.t;
+                }
+            }
+        }
+        out
+    }
+
+    /// The packet traversal. Each node's eight boxes are tested once for the whole packet,
+    /// with bounds over its rays (interval arithmetic on origin and reciprocal direction,
+    /// exact under rounding, see `PacketPre`), so a box is entered whenever any ray's own
+    /// slab test would enter it; at a leaf, each ray whose own slab test (the single-ray
+    /// one, bit for bit) enters the leaf's box runs the AVX leaf test with its own t_best.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn packet_avx(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        let mut out = [None; WIDTH];
+        if self.nodes.is_empty() || active == 0 {
+            return out;
+        }
+        let pre: [RayPre; WIDTH] = std::array::from_fn(|i| RayPre::new(o[i], d[i]));
+        // Rays that meet the root's box, as the single-ray path tests it.
+        let mut live = 0u8;
+        for (i, r) in pre.iter().enumerate() {
+            if active & (1 << i) != 0 && r.enters(self.root_lo, self.root_hi, t_min, t_max[i]) {
+                live |= 1 << i;
+            }
+        }
+        if live == 0 {
+            return out;
+        }
+        let Some(p) = PacketPre::new(&pre, live) else {
+            return self.singles8(o, d, live, t_min, t_max);
+        };
+        // Lanes of rays not traced hold -inf, so the packet's farthest t_best is a plain max.
+        let mut t_best = [f32::NEG_INFINITY; WIDTH];
+        for i in 0..WIDTH {
+            if live & (1 << i) != 0 {
+                t_best[i] = t_max[i];
+            }
+        }
+        let mut t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let mut best = [usize::MAX; WIDTH];
+        let mut stack: RayStack<(Child, f32, u32)> = RayStack::new();
+        let mut tn = [0.0f32; WIDTH];
+        let mut cur: Child = 0;
+        // Where cur's box is stored (node * 8 + slot); unused for the root, never a leaf
+        // except in a one-slot root, whose box is the root's box.
+        let mut cur_box = u32::MAX;
+        loop {
+            if wide::is_leaf(cur) {
+                let (first, count) = wide::leaf_range(cur);
+                let mut rays = if cur_box == u32::MAX {
+                    live
+                } else {
+                    let n = &self.nodes[(cur_box / 8) as usize];
+                    p.rays_entering(n, (cur_box % 8) as usize, t_min, &t_best) & live
+                };
+                let mut hit = false;
+                while rays != 0 {
+                    let i = rays.trailing_zeros() as usize;
+                    rays &= rays - 1;
+                    if let Some((t, k)) = leaf8_avx(self, &pre[i], first, count, t_min, t_best[i]) {
+                        t_best[i] = t;
+                        best[i] = k;
+                        hit = true;
+                    }
+                }
+                if hit {
+                    t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                }
+            } else {
+                let n = &self.nodes[cur as usize];
+                let mask = p.slab8(n, t_min, t_far, &mut tn);
+                let at = cur * 8;
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = n.child[i];
+                        cur_box = at + i as u32;
+                        continue;
+                    }
+                    if rest & (rest - 1) == 0 {
+                        let j = rest.trailing_zeros() as usize;
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push((n.child[far], tn[far], at + far as u32));
+                        cur = n.child[near];
+                        cur_box = at + near as u32;
+                        continue;
+                    }
+                    let mut m = mask;
+                    let mut k = 0;
+                    while m != 0 {
+                        let j = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        stack.push((n.child[j], tn[j], at + j as u32));
+                        k += 1;
+                    }
+                    stack.sort_top(k);
+                    if let Some((c, _, b)) = stack.pop() {
+                        cur = c;
+                        cur_box = b;
+                        continue;
+                    }
+                }
+            }
+            // The nearest child some ray may still need.
+            loop {
+                match stack.pop() {
+                    None => {
+                        for i in 0..WIDTH {
+                            if best[i] != usize::MAX {
+                                t_max[i] = t_best[i];
+                                out[i] = Some(TriangleHit {
+                                    t: t_best[i],
+                                    triangle: self.ids[best[i]],
+                                });
+                            }
+                        }
+                        return out;
+                    }
+                    Some((c, t, b)) if t <= t_far => {
+                        cur = c;
+                        cur_box = b;
+                        break;
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
     }
 
     /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
@@ -703,6 +879,153 @@ fn slab8_avx(r: &RayPre, n: &Node8, t_min: f32, t_max: f32, tn: &mut [f32; WIDTH
         _mm256_storeu_ps(tn.as_mut_ptr(), near)
     };
     _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+}
+
+/// A packet's bounds for the 8-box test, and its rays' own constants lane by lane.
+///
+/// Every traced ray runs the same sign on each axis, so the near plane of an axis is the
+/// same for all (lo for +, hi for -). Ray i's entry distance on an axis is
+/// fl(fl(plane - o_i) * inv_i); rounding is monotone in each operand and both factors lie
+/// in intervals [plane - o_max, plane - o_min] and [inv_min, inv_max], so the product at
+/// the right corner bounds every ray's value, bit-exactly rather than approximately: for the
+/// near plane the lower bound is (plane - o_far) * (inv_min where that difference is >= 0,
+/// else inv_max), with o_far = o_max on a + axis and o_min on a - axis; the far plane's
+/// upper bound mirrors it. Finite, nonzero reciprocals (checked in `new`) keep NaN out.
+#[cfg(target_arch = "x86_64")]
+struct PacketPre {
+    neg: [bool; 3],
+    /// Per axis: the origin bound the near (far) plane's difference takes.
+    o_near: [f32; 3],
+    o_far: [f32; 3],
+    inv_min: [f32; 3],
+    inv_max: [f32; 3],
+    /// Per axis, lane i = ray i's origin and reciprocal direction.
+    o: [[f32; WIDTH]; 3],
+    inv: [[f32; WIDTH]; 3],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl PacketPre {
+    /// None when the rays in `live` differ in direction sign on some axis, or one has a zero
+    /// (or non-finite) direction component or origin: those go one by one.
+    fn new(pre: &[RayPre; WIDTH], live: u8) -> Option<PacketPre> {
+        let mut p = PacketPre {
+            neg: [false; 3],
+            o_near: [0.0; 3],
+            o_far: [0.0; 3],
+            inv_min: [f32::INFINITY; 3],
+            inv_max: [f32::NEG_INFINITY; 3],
+            o: [[0.0; WIDTH]; 3],
+            inv: [[0.0; WIDTH]; 3],
+        };
+        let mut o_min = [f32::INFINITY; 3];
+        let mut o_max = [f32::NEG_INFINITY; 3];
+        let (mut all_neg, mut all_pos) = ([true; 3], [true; 3]);
+        for (i, r) in pre.iter().enumerate() {
+            for a in 0..3 {
+                p.o[a][i] = r.o[a];
+                p.inv[a][i] = r.inv[a];
+            }
+            if live & (1 << i) == 0 {
+                continue;
+            }
+            for a in 0..3 {
+                let (o, inv) = (r.o[a], r.inv[a]);
+                if !o.is_finite() || !inv.is_finite() {
+                    return None;
+                }
+                all_neg[a] &= inv < 0.0;
+                all_pos[a] &= inv > 0.0;
+                o_min[a] = o_min[a].min(o);
+                o_max[a] = o_max[a].max(o);
+                p.inv_min[a] = p.inv_min[a].min(inv);
+                p.inv_max[a] = p.inv_max[a].max(inv);
+            }
+        }
+        for a in 0..3 {
+            if !(all_neg[a] || all_pos[a]) {
+                return None;
+            }
+            p.neg[a] = all_neg[a];
+            (p.o_near[a], p.o_far[a]) = if all_neg[a] {
+                (o_min[a], o_max[a])
+            } else {
+                (o_max[a], o_min[a])
+            };
+        }
+        Some(p)
+    }
+
+    /// The packet against a node's eight boxes: bit i set when some ray of the packet may
+    /// enter slot i within [t_min, t_far] (never unset where a ray's own `slab8` sets it);
+    /// `tn` gets lower bounds of the rays' entry distances.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn slab8(&self, n: &Node8, t_min: f32, t_far: f32, tn: &mut [f32; WIDTH]) -> u32 {
+        use std::arch::x86_64::*;
+        #[allow(unsafe_code)]
+        // SAFETY: an axis row [Vec4; 2] is 8 contiguous f32; unaligned loads ask nothing more.
+        let ld = |v: &[Vec4; 2]| unsafe { _mm256_loadu_ps(v.as_ptr().cast::<f32>()) };
+        let (sub, mul, blend, set) = (
+            _mm256_sub_ps,
+            _mm256_mul_ps,
+            _mm256_blendv_ps,
+            _mm256_set1_ps,
+        );
+        let side = |a: usize| {
+            let (np, fp) = if self.neg[a] {
+                (&n.hi[a], &n.lo[a])
+            } else {
+                (&n.lo[a], &n.hi[a])
+            };
+            let (lo, hi) = (set(self.inv_min[a]), set(self.inv_max[a]));
+            // blendv takes its second operand where the difference is negative.
+            let x = sub(ld(np), set(self.o_near[a]));
+            let y = sub(ld(fp), set(self.o_far[a]));
+            (mul(x, blend(lo, hi, x)), mul(y, blend(hi, lo, y)))
+        };
+        let (nx, fx) = side(0);
+        let (ny, fy) = side(1);
+        let (nz, fz) = side(2);
+        let near = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, set(t_min)));
+        let far = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, set(t_far)));
+        let far = mul(far, set(1.000_000_4));
+        #[allow(unsafe_code)]
+        // SAFETY: `tn` is 8 f32, exactly one unaligned 256-bit store.
+        unsafe {
+            _mm256_storeu_ps(tn.as_mut_ptr(), near)
+        };
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+    }
+
+    /// Bit i set when ray i's own slab test (`slab8_avx`'s operations in its order, lane i)
+    /// enters slot `s` of `n` within [t_min, t_best[i]].
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn rays_entering(&self, n: &Node8, s: usize, t_min: f32, t_best: &[f32; WIDTH]) -> u8 {
+        use std::arch::x86_64::*;
+        #[allow(unsafe_code)]
+        // SAFETY: each row is 8 f32, one unaligned 256-bit load.
+        let ld = |v: &[f32; WIDTH]| unsafe { _mm256_loadu_ps(v.as_ptr()) };
+        let (sub, mul, set) = (_mm256_sub_ps, _mm256_mul_ps, _mm256_set1_ps);
+        let (h, l) = (s / 4, s % 4);
+        let slab = |a: usize| {
+            let (np, fp) = if self.neg[a] {
+                (n.hi[a][h][l], n.lo[a][h][l])
+            } else {
+                (n.lo[a][h][l], n.hi[a][h][l])
+            };
+            let (o, inv) = (ld(&self.o[a]), ld(&self.inv[a]));
+            (mul(sub(set(np), o), inv), mul(sub(set(fp), o), inv))
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let near = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, set(t_min)));
+        let far = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, ld(t_best)));
+        let far = mul(far, set(1.000_000_4));
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u8
+    }
 }
 
 #[cfg(test)]
@@ -1020,6 +1343,180 @@ mod tests {
         }
     }
 
+    /// Packets of the eight rays `rays[k..k + 8]` under every `active` mask in `masks`: each
+    /// traced ray gets the single-ray t bit for bit (and a triangle hit at that t), its
+    /// t_max lowered to it; rays left out get nothing and keep their t_max. Returns how
+    /// many rays were compared.
+    fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8]) -> usize {
+        let mut compared = 0;
+        for (p, chunk) in rays.chunks_exact(WIDTH).enumerate() {
+            let o: [Vec3A; WIDTH] = std::array::from_fn(|i| chunk[i].origin.into());
+            let d: [Vec3A; WIDTH] = std::array::from_fn(|i| chunk[i].direction.into());
+            for &active in masks {
+                let mut limits = [f32::INFINITY; WIDTH];
+                limits[3] = 7.5; // one ray with a finite limit
+                let mut t_packet = limits;
+                let got = bvh.closest_hit8(&o, &d, active, t_min, &mut t_packet);
+                for i in 0..WIDTH {
+                    let want = if active & (1 << i) != 0 {
+                        bvh.closest_hit(o[i], d[i], t_min, limits[i])
+                    } else {
+                        None
+                    };
+                    match (got[i], want) {
+                        (None, None) => {}
+                        (Some(g), Some(w)) => {
+                            assert_eq!(
+                                g.t.to_bits(),
+                                w.t.to_bits(),
+                                "packet {p} ray {i} mask {active:#x}"
+                            );
+                            if g.triangle != w.triangle {
+                                // A tie: the other triangle must be hit at that very t.
+                                let k = bvh
+                                    .ids
+                                    .iter()
+                                    .position(|&id| id == g.triangle)
+                                    .expect("a stored id");
+                                assert_eq!(
+                                    bvh.tri(k).hit(chunk[i].origin, chunk[i].direction),
+                                    Some(g.t),
+                                    "packet {p} ray {i}: triangle {} not hit at {}",
+                                    g.triangle,
+                                    g.t
+                                );
+                            }
+                        }
+                        _ => panic!(
+                            "packet {p} ray {i} mask {active:#x}: {:?} vs single {want:?}",
+                            got[i]
+                        ),
+                    }
+                    let want_t = want.map_or(limits[i], |h| h.t);
+                    assert_eq!(
+                        t_packet[i].to_bits(),
+                        want_t.to_bits(),
+                        "packet {p} ray {i}: t_max"
+                    );
+                }
+                // The portable fallback (single rays) agrees too.
+                let mut t_singles = limits;
+                let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
+                assert_eq!(
+                    t_singles.map(f32::to_bits),
+                    t_packet.map(f32::to_bits),
+                    "packet {p}"
+                );
+                assert_eq!(
+                    singles.map(|h| h.map(|h| h.t)),
+                    got.map(|h| h.map(|h| h.t)),
+                    "packet {p}"
+                );
+                compared += active.count_ones() as usize;
+            }
+        }
+        compared
+    }
+
+    /// Primary rays of a pinhole camera at `eye` looking at `at`, in 4x2 pixel tiles (the
+    /// bench's packets): `n` x `n` pixels, n a multiple of 4, spanning `fov` radians.
+    fn pinhole_tiles(eye: Vec3, at: Vec3, n: usize, fov: f32) -> Vec<Ray> {
+        camera_tiles(eye, at, n, fov, 0.0)
+    }
+
+    /// `pinhole_tiles` with origins spread over the screen too (`spread` = 1: a screen as
+    /// wide as the view at distance 1), so a packet's origins differ.
+    fn camera_tiles(eye: Vec3, at: Vec3, n: usize, fov: f32, spread: f32) -> Vec<Ray> {
+        let f = (at - eye).normalize();
+        let r = f.cross(Vec3::Y).normalize();
+        let u = r.cross(f);
+        let h = (fov * 0.5).tan();
+        let mut rays = Vec::new();
+        for ty in (0..n).step_by(2) {
+            for tx in (0..n).step_by(4) {
+                for k in 0..WIDTH {
+                    let (i, j) = (tx + (k & 3), ty + (k >> 2));
+                    let x = (2.0 * (i as f32 + 0.5) / n as f32 - 1.0) * h;
+                    let y = (1.0 - 2.0 * (j as f32 + 0.5) / n as f32) * h;
+                    let o = eye + (x * r + y * u) * spread;
+                    rays.push(Ray::new(o, (f + x * r + y * u).normalize()));
+                }
+            }
+        }
+        rays
+    }
+
+    const MASKS: [u8; 5] = [0xff, 0x01, 0x80, 0x5a, 0x00];
+
+    #[test]
+    fn packets_agree_with_single_rays_on_random_meshes() {
+        for (n, seed) in [(1, 7), (9, 1), (2000, 13), (20_000, 17)] {
+            let (pos, tris) = random_mesh(n, seed);
+            let bvh = build_checked(&pos, &tris);
+            let mut compared = 0;
+            // Coherent tiles from pinholes on every side (all eight sign octants).
+            for eye in [
+                Vec3::new(0.3, 0.4, 6.0),
+                Vec3::new(-5.0, -4.0, -3.0),
+                Vec3::new(4.0, -5.0, 2.0),
+                Vec3::new(-0.2, 6.0, -4.0),
+            ] {
+                let rays = pinhole_tiles(eye, Vec3::new(0.1, -0.2, 0.05), 32, 0.9);
+                compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+                // Origins differing within a packet (the origin bounds matter), and nearly
+                // parallel rays (the reciprocal bounds collapse).
+                for (fov, spread) in [(0.9, 2.0), (0.01, 400.0)] {
+                    let rays = camera_tiles(eye, Vec3::new(-0.1, 0.2, 0.0), 32, fov, spread);
+                    compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+                }
+                // A camera inside the mesh's box, with t_min > 0.
+                let inside = pinhole_tiles(eye * 0.05, Vec3::ZERO, 16, 1.2);
+                compared += assert_packets_agree(&bvh, &inside, 0.3, &MASKS);
+            }
+            // Incoherent packets: random origins and directions, mixed signs.
+            let rays = rays_toward(Vec3::ZERO, 2.0, 1024, 77 + seed);
+            compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+            // Axis-parallel rays (zero direction components) amid coherent ones.
+            let mut mixed = pinhole_tiles(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 8, 0.6);
+            for (k, r) in mixed.iter_mut().enumerate().step_by(5) {
+                *r = Ray::new(r.origin + Vec3::new(0.01 * k as f32, 0.0, 0.0), Vec3::NEG_Z);
+            }
+            compared += assert_packets_agree(&bvh, &mixed, 0.0, &MASKS);
+            assert!(compared > 1000, "{compared} rays compared");
+        }
+    }
+
+    #[test]
+    fn packets_on_empty_and_one_triangle_meshes() {
+        let rays = pinhole_tiles(Vec3::new(0.2, 0.3, 3.0), Vec3::new(0.3, 0.3, 0.0), 8, 0.8);
+        let empty = build_checked(&[], &[]);
+        let o: [Vec3A; WIDTH] = std::array::from_fn(|i| rays[i].origin.into());
+        let d: [Vec3A; WIDTH] = std::array::from_fn(|i| rays[i].direction.into());
+        let mut t_max = [f32::INFINITY; WIDTH];
+        assert_eq!(
+            empty.closest_hit8(&o, &d, 0xff, 0.0, &mut t_max),
+            [None; WIDTH]
+        );
+        assert_eq!(t_max, [f32::INFINITY; WIDTH]);
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let one = build_checked(&pos, &[[0, 1, 2]]);
+        assert_packets_agree(&one, &rays, 0.0, &MASKS);
+        // The middle rays of the tiles do hit the triangle.
+        let hits: usize = rays
+            .chunks_exact(WIDTH)
+            .map(|c| {
+                let o: [Vec3A; WIDTH] = std::array::from_fn(|i| c[i].origin.into());
+                let d: [Vec3A; WIDTH] = std::array::from_fn(|i| c[i].direction.into());
+                let mut t = [f32::INFINITY; WIDTH];
+                one.closest_hit8(&o, &d, 0xff, 0.0, &mut t)
+                    .iter()
+                    .flatten()
+                    .count()
+            })
+            .sum();
+        assert!(hits > 0 && hits < rays.len(), "{hits} hits");
+    }
+
     #[test]
     fn shared_meshes_agree_with_brute_force() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
@@ -1053,6 +1550,13 @@ mod tests {
                 &bvh,
                 &rays_toward(b.center(), radius, rays, 41),
             );
+            // Packets: pinhole tiles from two sides, and the incoherent rays.
+            for eye in [Vec3::new(0.3, 0.5, 3.0), Vec3::new(-2.0, -1.5, -2.5)] {
+                let tiles = pinhole_tiles(b.center() + eye * radius, b.center(), 64, 0.8);
+                assert_packets_agree(&bvh, &tiles, 0.0, &MASKS);
+            }
+            let mixed = rays_toward(b.center(), radius, 512, 43);
+            assert_packets_agree(&bvh, &mixed, 0.0, &MASKS);
         }
     }
 }
