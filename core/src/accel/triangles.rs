@@ -544,20 +544,12 @@ impl TriangleBvh {
         if self.nodes.is_empty() || active == 0 {
             return out;
         }
-        let pre: [RayPre; WIDTH] = std::array::from_fn(|i| RayPre::new(o[i], d[i]));
-        // Rays that meet the root's box, as the single-ray path tests it.
-        let mut live = 0u8;
-        for (i, r) in pre.iter().enumerate() {
-            if active & (1 << i) != 0 && r.enters(self.root_lo, self.root_hi, t_min, t_max[i]) {
-                live |= 1 << i;
-            }
-        }
+        let Some((p, live)) = PacketPre::new(o, d, active, self, t_min, t_max) else {
+            return self.singles8(o, d, active, t_min, t_max);
+        };
         if live == 0 {
             return out;
         }
-        let Some(p) = PacketPre::new(&pre, live) else {
-            return self.singles8(o, d, live, t_min, t_max);
-        };
         // Lanes of rays not traced hold -inf, so the packet's farthest t_best is a plain max.
         let mut t_best = [f32::NEG_INFINITY; WIDTH];
         for i in 0..WIDTH {
@@ -586,7 +578,9 @@ impl TriangleBvh {
                 while rays != 0 {
                     let i = rays.trailing_zeros() as usize;
                     rays &= rays - 1;
-                    if let Some((t, k)) = leaf8_avx(self, &pre[i], first, count, t_min, t_best[i]) {
+                    if let Some((t, k)) =
+                        leaf8_od_avx(self, o[i], d[i], first, count, t_min, t_best[i])
+                    {
                         t_best[i] = t;
                         best[i] = k;
                         hit = true;
@@ -748,7 +742,28 @@ fn leaf8_avx(
     t_min: f32,
     t_best: f32,
 ) -> Option<(f32, usize)> {
+    leaf8_od_avx(bvh, r.o, r.d, first, count, t_min, t_best)
+}
+
+/// `leaf8_avx` for a ray given by origin and direction.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+fn leaf8_od_avx(
+    bvh: &TriangleBvh,
+    ro: Vec3A,
+    rd: Vec3A,
+    first: usize,
+    count: usize,
+    t_min: f32,
+    t_best: f32,
+) -> Option<(f32, usize)> {
     use std::arch::x86_64::*;
+    struct R {
+        o: Vec3A,
+        d: Vec3A,
+    }
+    let r = R { o: ro, d: rd };
     let ld = |k: usize| {
         let at = k * bvh.stride + first;
         match bvh.soa.get(at..at + WIDTH) {
@@ -900,60 +915,111 @@ struct PacketPre {
     inv_min: [f32; 3],
     inv_max: [f32; 3],
     /// Per axis, lane i = ray i's origin and reciprocal direction.
-    o: [[f32; WIDTH]; 3],
-    inv: [[f32; WIDTH]; 3],
+    o: [std::arch::x86_64::__m256; 3],
+    inv: [std::arch::x86_64::__m256; 3],
 }
 
 #[cfg(target_arch = "x86_64")]
 impl PacketPre {
-    /// None when the rays in `live` differ in direction sign on some axis, or one has a zero
-    /// (or non-finite) direction component or origin: those go one by one.
-    fn new(pre: &[RayPre; WIDTH], live: u8) -> Option<PacketPre> {
+    /// The packet's constants and the rays of `active` that meet the root's box (tested as
+    /// `RayPre::enters` tests it). None when an active ray has a zero (or non-finite)
+    /// direction component or a non-finite origin, or when the rays meeting the root differ
+    /// in direction sign on some axis: those go one by one. Built in registers, eight rays
+    /// per instruction (one division per axis instead of a reciprocal per ray).
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn new(
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        bvh: &TriangleBvh,
+        t_min: f32,
+        t_max: &[f32; WIDTH],
+    ) -> Option<(PacketPre, u8)> {
+        use std::arch::x86_64::*;
+        let col = |v: &[Vec3A; WIDTH], a: usize| {
+            _mm256_setr_ps(
+                v[0][a], v[1][a], v[2][a], v[3][a], v[4][a], v[5][a], v[6][a], v[7][a],
+            )
+        };
+        let (set, sub, mul) = (_mm256_set1_ps, _mm256_sub_ps, _mm256_mul_ps);
+        let ov = [col(o, 0), col(o, 1), col(o, 2)];
+        // IEEE division, lane by lane the value of `Vec3A::recip`.
+        let iv = [0, 1, 2].map(|a| _mm256_div_ps(set(1.0), col(d, a)));
+        let bits = |m: __m256| _mm256_movemask_ps(m) as u8;
+        let abs = |v: __m256| _mm256_andnot_ps(set(-0.0), v);
+        let inf = set(f32::INFINITY);
+        let mut finite = 0xff;
+        for a in 0..3 {
+            finite &= bits(_mm256_cmp_ps::<_CMP_LT_OQ>(abs(ov[a]), inf));
+            finite &= bits(_mm256_cmp_ps::<_CMP_LT_OQ>(abs(iv[a]), inf));
+            finite &= bits(_mm256_cmp_ps::<_CMP_NEQ_OQ>(iv[a], _mm256_setzero_ps()));
+        }
+        if finite & active != active {
+            return None;
+        }
+        // The root's box per ray, `RayPre::enters`'s operations (no NaN can arise here: every
+        // reciprocal is finite and nonzero).
+        #[allow(unsafe_code)]
+        // SAFETY: `t_max` is 8 f32, one unaligned 256-bit load.
+        let tmax = unsafe { _mm256_loadu_ps(t_max.as_ptr()) };
+        let (mut near, mut far) = (set(t_min), tmax);
+        for a in 0..3 {
+            let t0 = mul(sub(set(bvh.root_lo[a]), ov[a]), iv[a]);
+            let t1 = mul(sub(set(bvh.root_hi[a]), ov[a]), iv[a]);
+            near = _mm256_max_ps(near, _mm256_min_ps(t0, t1));
+            far = _mm256_min_ps(far, _mm256_max_ps(t0, t1));
+        }
+        let live = bits(_mm256_cmp_ps::<_CMP_LE_OQ>(
+            near,
+            mul(far, set(1.000_000_4)),
+        )) & active;
         let mut p = PacketPre {
             neg: [false; 3],
             o_near: [0.0; 3],
             o_far: [0.0; 3],
-            inv_min: [f32::INFINITY; 3],
-            inv_max: [f32::NEG_INFINITY; 3],
-            o: [[0.0; WIDTH]; 3],
-            inv: [[0.0; WIDTH]; 3],
+            inv_min: [0.0; 3],
+            inv_max: [0.0; 3],
+            o: ov,
+            inv: iv,
         };
-        let mut o_min = [f32::INFINITY; 3];
-        let mut o_max = [f32::NEG_INFINITY; 3];
-        let (mut all_neg, mut all_pos) = ([true; 3], [true; 3]);
-        for (i, r) in pre.iter().enumerate() {
-            for a in 0..3 {
-                p.o[a][i] = r.o[a];
-                p.inv[a][i] = r.inv[a];
-            }
-            if live & (1 << i) == 0 {
-                continue;
-            }
-            for a in 0..3 {
-                let (o, inv) = (r.o[a], r.inv[a]);
-                if !o.is_finite() || !inv.is_finite() {
-                    return None;
-                }
-                all_neg[a] &= inv < 0.0;
-                all_pos[a] &= inv > 0.0;
-                o_min[a] = o_min[a].min(o);
-                o_max[a] = o_max[a].max(o);
-                p.inv_min[a] = p.inv_min[a].min(inv);
-                p.inv_max[a] = p.inv_max[a].max(inv);
-            }
+        if live == 0 {
+            return Some((p, 0));
         }
+        // Lanes of the live rays as a mask, for the bounds over them.
+        let sel = |lo: i32| _mm_setr_epi32(lo, lo << 1, lo << 2, lo << 3);
+        let b = _mm_set1_epi32(live as i32);
+        let lane = |s: __m128i| _mm_cmpeq_epi32(_mm_and_si128(b, s), s);
+        let lanes = _mm256_castsi256_ps(_mm256_set_m128i(lane(sel(16)), lane(sel(1))));
+        // Horizontal min and max of the eight lanes.
+        let hmin = |v: __m256| {
+            let v = _mm256_min_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+            let v = _mm256_min_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+            _mm256_cvtss_f32(_mm256_min_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v)))
+        };
+        let hmax = |v: __m256| {
+            let v = _mm256_max_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+            let v = _mm256_max_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+            _mm256_cvtss_f32(_mm256_max_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v)))
+        };
+        let neg_inf = set(f32::NEG_INFINITY);
         for a in 0..3 {
-            if !(all_neg[a] || all_pos[a]) {
+            let neg = bits(_mm256_cmp_ps::<_CMP_LT_OQ>(iv[a], _mm256_setzero_ps())) & live;
+            if neg != 0 && neg != live {
                 return None;
             }
-            p.neg[a] = all_neg[a];
-            (p.o_near[a], p.o_far[a]) = if all_neg[a] {
-                (o_min[a], o_max[a])
+            p.neg[a] = neg != 0;
+            let o_min = hmin(_mm256_blendv_ps(inf, ov[a], lanes));
+            let o_max = hmax(_mm256_blendv_ps(neg_inf, ov[a], lanes));
+            p.inv_min[a] = hmin(_mm256_blendv_ps(inf, iv[a], lanes));
+            p.inv_max[a] = hmax(_mm256_blendv_ps(neg_inf, iv[a], lanes));
+            (p.o_near[a], p.o_far[a]) = if p.neg[a] {
+                (o_min, o_max)
             } else {
-                (o_max[a], o_min[a])
+                (o_max, o_min)
             };
         }
-        Some(p)
+        Some((p, live))
     }
 
     /// The packet against a node's eight boxes: bit i set when some ray of the packet may
@@ -1015,7 +1081,7 @@ impl PacketPre {
             } else {
                 (n.lo[a][h][l], n.hi[a][h][l])
             };
-            let (o, inv) = (ld(&self.o[a]), ld(&self.inv[a]));
+            let (o, inv) = (self.o[a], self.inv[a]);
             (mul(sub(set(np), o), inv), mul(sub(set(fp), o), inv))
         };
         let (nx, fx) = slab(0);
