@@ -568,6 +568,9 @@ impl TriangleBvh {
         loop {
             if wide::is_leaf(cur) {
                 let (first, count) = wide::leaf_range(cur);
+                // Only the rays whose own slab test enters the leaf's box: testing every
+                // live ray instead cost the Stanford bunny 28.0 -> 25.6 Mrays/s (bunny_1k
+                // 43.4 vs 43.8, a wash; 1 thread, medians of 9, alternating runs).
                 let mut rays = if cur_box == u32::MAX {
                     live
                 } else {
