@@ -82,6 +82,9 @@ pub struct BenchArgs {
     pub threads: usize,
     #[arg(long, default_value_t = 5)]
     pub repeat: usize,
+    /// Trace 4x2 pixel tiles as 8-ray packets (as Embree's rtcIntersect8 loop does).
+    #[arg(long)]
+    pub packets: bool,
 }
 
 #[derive(clap::Args, Debug)]

@@ -181,7 +181,7 @@ macro_rules! closest_hit {
                         // Two children, the common case below the top: no sort needed.
                         let j = rest.trailing_zeros() as usize;
                         let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
-                        stack.push(n.child[far], tn[far]);
+                        stack.push((n.child[far], tn[far]));
                         cur = n.child[near];
                         continue;
                     }
@@ -191,7 +191,7 @@ macro_rules! closest_hit {
                     while m != 0 {
                         let j = m.trailing_zeros() as usize;
                         m &= m - 1;
-                        stack.push(n.child[j], tn[j]);
+                        stack.push((n.child[j], tn[j]));
                         k += 1;
                     }
                     stack.sort_top(k);
@@ -434,7 +434,7 @@ impl TriangleBvh {
         let r = RayPre::new(ray.origin.into(), ray.direction.into());
         let mut stack = RayStack::new();
         let mut tn = [0.0f32; WIDTH];
-        stack.push(0, t_min);
+        stack.push((0, t_min));
         while let Some((c, _)) = stack.pop() {
             if wide::is_leaf(c) {
                 let (first, count) = wide::leaf_range(c);
@@ -456,7 +456,7 @@ impl TriangleBvh {
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                stack.push(n.child[i], tn[i]);
+                stack.push((n.child[i], tn[i]));
             }
         }
     }
@@ -480,6 +480,179 @@ impl TriangleBvh {
             return unsafe { self.intersect_avx(o, d, t_min, t_max) };
         }
         self.intersect_portable(o, d, t_min, t_max)
+    }
+
+    /// Closest hits of a packet of eight rays (`o[i]`, `d[i]`) in (t_min, t_max[i]), for the
+    /// rays whose bit is set in `active`; a ray that hits has its `t_max` lowered to the hit.
+    /// Each ray gets the t `closest_hit` gives it, bit for bit (the triangle may differ only
+    /// where two are hit at the very same t). Made for coherent rays (a pixel tile's primary
+    /// rays): with AVX, one traversal for the packet, which falls back to single rays when
+    /// the active rays' directions differ in sign on some axis (or one is axis-parallel).
+    pub fn closest_hit8(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above.
+            return unsafe { self.packet_avx(o, d, active, t_min, t_max) };
+        }
+        self.singles8(o, d, active, t_min, t_max)
+    }
+
+    /// `closest_hit8` one ray at a time.
+    fn singles8(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        let mut out = [None; WIDTH];
+        for i in 0..WIDTH {
+            if active & (1 << i) != 0 {
+                out[i] = self.closest_hit(o[i], d[i], t_min, t_max[i]);
+                if let Some(h) = out[i] {
+                    t_max[i] = h.t;
+                }
+            }
+        }
+        out
+    }
+
+    /// The packet traversal. Each node's eight boxes are tested once for the whole packet,
+    /// with bounds over its rays (interval arithmetic on origin and reciprocal direction,
+    /// exact under rounding, see `PacketPre`), so a box is entered whenever any ray's own
+    /// slab test would enter it; at a leaf, each ray whose own slab test (the single-ray
+    /// one, bit for bit) enters the leaf's box runs the AVX leaf test with its own t_best.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn packet_avx(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        let mut out = [None; WIDTH];
+        if self.nodes.is_empty() || active == 0 {
+            return out;
+        }
+        let Some((p, live)) = PacketPre::new(o, d, active, self, t_min, t_max) else {
+            return self.singles8(o, d, active, t_min, t_max);
+        };
+        if live == 0 {
+            return out;
+        }
+        // Lanes of rays not traced hold -inf, so the packet's farthest t_best is a plain max.
+        let mut t_best = [f32::NEG_INFINITY; WIDTH];
+        for i in 0..WIDTH {
+            if live & (1 << i) != 0 {
+                t_best[i] = t_max[i];
+            }
+        }
+        let mut t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let mut best = [usize::MAX; WIDTH];
+        let mut stack: RayStack<(Child, f32, u32)> = RayStack::new();
+        let mut tn = [0.0f32; WIDTH];
+        let mut cur: Child = 0;
+        // Where cur's box is stored (node * 8 + slot); unused for the root, never a leaf
+        // except in a one-slot root, whose box is the root's box.
+        let mut cur_box = u32::MAX;
+        loop {
+            if wide::is_leaf(cur) {
+                let (first, count) = wide::leaf_range(cur);
+                // Only the rays whose own slab test enters the leaf's box: testing every
+                // live ray instead cost the Stanford bunny 28.0 -> 25.6 Mrays/s (bunny_1k
+                // 43.4 vs 43.8, a wash; 1 thread, medians of 9, alternating runs).
+                let mut rays = if cur_box == u32::MAX {
+                    live
+                } else {
+                    let n = &self.nodes[(cur_box / 8) as usize];
+                    p.rays_entering(n, (cur_box % 8) as usize, t_min, &t_best) & live
+                };
+                let mut hit = false;
+                while rays != 0 {
+                    let i = rays.trailing_zeros() as usize;
+                    rays &= rays - 1;
+                    if let Some((t, k)) =
+                        leaf8_avx(self, &(o[i], d[i]), first, count, t_min, t_best[i])
+                    {
+                        t_best[i] = t;
+                        best[i] = k;
+                        hit = true;
+                    }
+                }
+                if hit {
+                    t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                }
+            } else {
+                let n = &self.nodes[cur as usize];
+                let mask = p.slab8(n, t_min, t_far, &mut tn);
+                let at = cur * 8;
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = n.child[i];
+                        cur_box = at + i as u32;
+                        continue;
+                    }
+                    if rest & (rest - 1) == 0 {
+                        let j = rest.trailing_zeros() as usize;
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push((n.child[far], tn[far], at + far as u32));
+                        cur = n.child[near];
+                        cur_box = at + near as u32;
+                        continue;
+                    }
+                    let mut m = mask;
+                    let mut k = 0;
+                    while m != 0 {
+                        let j = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        stack.push((n.child[j], tn[j], at + j as u32));
+                        k += 1;
+                    }
+                    stack.sort_top(k);
+                    if let Some((c, _, b)) = stack.pop() {
+                        cur = c;
+                        cur_box = b;
+                        continue;
+                    }
+                }
+            }
+            // The nearest child some ray may still need.
+            loop {
+                match stack.pop() {
+                    None => {
+                        for i in 0..WIDTH {
+                            if best[i] != usize::MAX {
+                                t_max[i] = t_best[i];
+                                out[i] = Some(TriangleHit {
+                                    t: t_best[i],
+                                    triangle: self.ids[best[i]],
+                                });
+                            }
+                        }
+                        return out;
+                    }
+                    Some((c, t, b)) if t <= t_far => {
+                        cur = c;
+                        cur_box = b;
+                        break;
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
     }
 
     /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
@@ -556,6 +729,38 @@ fn has_avx() -> bool {
     false
 }
 
+/// A ray as the leaf test reads it: the single-ray traversal's `RayPre`, or a packet's
+/// (origin, direction). Generic rather than one function taking (o, d) that both call: with
+/// two callers LLVM stopped inlining the leaf test into the single-ray traversal, which cost
+/// single rays 4-5% (bunny_1k 29.2 -> 27.8 Mrays/s, Stanford bunny 15.5 -> 14.9, dragon
+/// 13.2 -> 12.8; 1 thread, medians of 9, alternating runs).
+trait LeafRay {
+    fn origin(&self) -> Vec3A;
+    fn direction(&self) -> Vec3A;
+}
+
+impl LeafRay for RayPre {
+    #[inline(always)]
+    fn origin(&self) -> Vec3A {
+        self.o
+    }
+    #[inline(always)]
+    fn direction(&self) -> Vec3A {
+        self.d
+    }
+}
+
+impl LeafRay for (Vec3A, Vec3A) {
+    #[inline(always)]
+    fn origin(&self) -> Vec3A {
+        self.0
+    }
+    #[inline(always)]
+    fn direction(&self) -> Vec3A {
+        self.1
+    }
+}
+
 /// `TriangleBvh::leaf_scalar` for a whole leaf at once: the same Möller–Trumbore steps in
 /// the same order on eight lanes (no FMA), so t is bit for bit the scalar (and brute-force)
 /// value. Measured against the scalar loop over (v0, e1, e2) records (medians of 9 frames,
@@ -565,15 +770,16 @@ fn has_avx() -> bool {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[inline]
-fn leaf8_avx(
+fn leaf8_avx<L: LeafRay>(
     bvh: &TriangleBvh,
-    r: &RayPre,
+    ray: &L,
     first: usize,
     count: usize,
     t_min: f32,
     t_best: f32,
 ) -> Option<(f32, usize)> {
     use std::arch::x86_64::*;
+    let (o, d) = (ray.origin(), ray.direction());
     let ld = |k: usize| {
         let at = k * bvh.stride + first;
         match bvh.soa.get(at..at + WIDTH) {
@@ -587,9 +793,9 @@ fn leaf8_avx(
     let (e1x, e1y, e1z) = (ld(3), ld(4), ld(5));
     let (e2x, e2y, e2z) = (ld(6), ld(7), ld(8));
     let (dx, dy, dz) = (
-        _mm256_set1_ps(r.d.x),
-        _mm256_set1_ps(r.d.y),
-        _mm256_set1_ps(r.d.z),
+        _mm256_set1_ps(d.x),
+        _mm256_set1_ps(d.y),
+        _mm256_set1_ps(d.z),
     );
     let (mul, sub, add) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps);
     // glam's Vec3::cross and dot, lane-wise, in their operation order.
@@ -604,9 +810,9 @@ fn leaf8_avx(
     let (px, py, pz) = cross(dx, dy, dz, e2x, e2y, e2z);
     let det = dot(e1x, e1y, e1z, px, py, pz);
     let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
-    let sx = sub(_mm256_set1_ps(r.o.x), v0x);
-    let sy = sub(_mm256_set1_ps(r.o.y), v0y);
-    let sz = sub(_mm256_set1_ps(r.o.z), v0z);
+    let sx = sub(_mm256_set1_ps(o.x), v0x);
+    let sy = sub(_mm256_set1_ps(o.y), v0y);
+    let sz = sub(_mm256_set1_ps(o.z), v0z);
     let u = mul(dot(sx, sy, sz, px, py, pz), inv_det);
     let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
     // Ordered compares are false for NaN, as the scalar tests are.
@@ -704,6 +910,204 @@ fn slab8_avx(r: &RayPre, n: &Node8, t_min: f32, t_max: f32, tn: &mut [f32; WIDTH
         _mm256_storeu_ps(tn.as_mut_ptr(), near)
     };
     _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+}
+
+/// A packet's bounds for the 8-box test, and its rays' own constants lane by lane.
+///
+/// Every traced ray runs the same sign on each axis, so the near plane of an axis is the
+/// same for all (lo for +, hi for -). Ray i's entry distance on an axis is
+/// fl(fl(plane - o_i) * inv_i); rounding is monotone in each operand and both factors lie
+/// in intervals [plane - o_max, plane - o_min] and [inv_min, inv_max], so the product at
+/// the right corner bounds every ray's value, bit-exactly rather than approximately: for the
+/// near plane the lower bound is (plane - o_far) * (inv_min where that difference is >= 0,
+/// else inv_max), with o_far = o_max on a + axis and o_min on a - axis; the far plane's
+/// upper bound mirrors it. Finite, nonzero reciprocals (checked in `new`) keep NaN out.
+#[cfg(target_arch = "x86_64")]
+struct PacketPre {
+    neg: [bool; 3],
+    /// Per axis: the origin bound the near (far) plane's difference takes.
+    o_near: [f32; 3],
+    o_far: [f32; 3],
+    inv_min: [f32; 3],
+    inv_max: [f32; 3],
+    /// Per axis, lane i = ray i's origin and reciprocal direction.
+    o: [std::arch::x86_64::__m256; 3],
+    inv: [std::arch::x86_64::__m256; 3],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl PacketPre {
+    /// The packet's constants and the rays of `active` that meet the root's box (tested as
+    /// `RayPre::enters` tests it). None when an active ray has a zero (or non-finite)
+    /// direction component or a non-finite origin, or when the rays meeting the root differ
+    /// in direction sign on some axis: those go one by one. Built in registers, eight rays
+    /// per instruction (one division per axis instead of a reciprocal per ray).
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn new(
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        bvh: &TriangleBvh,
+        t_min: f32,
+        t_max: &[f32; WIDTH],
+    ) -> Option<(PacketPre, u8)> {
+        use std::arch::x86_64::*;
+        let col = |v: &[Vec3A; WIDTH], a: usize| {
+            _mm256_setr_ps(
+                v[0][a], v[1][a], v[2][a], v[3][a], v[4][a], v[5][a], v[6][a], v[7][a],
+            )
+        };
+        let (set, sub, mul) = (_mm256_set1_ps, _mm256_sub_ps, _mm256_mul_ps);
+        let ov = [col(o, 0), col(o, 1), col(o, 2)];
+        // IEEE division, lane by lane the value of `Vec3A::recip`.
+        let iv = [0, 1, 2].map(|a| _mm256_div_ps(set(1.0), col(d, a)));
+        let bits = |m: __m256| _mm256_movemask_ps(m) as u8;
+        let abs = |v: __m256| _mm256_andnot_ps(set(-0.0), v);
+        let inf = set(f32::INFINITY);
+        let mut finite = 0xff;
+        for a in 0..3 {
+            finite &= bits(_mm256_cmp_ps::<_CMP_LT_OQ>(abs(ov[a]), inf));
+            finite &= bits(_mm256_cmp_ps::<_CMP_LT_OQ>(abs(iv[a]), inf));
+            finite &= bits(_mm256_cmp_ps::<_CMP_NEQ_OQ>(iv[a], _mm256_setzero_ps()));
+        }
+        if finite & active != active {
+            return None;
+        }
+        // The root's box per ray, `RayPre::enters`'s operations (no NaN can arise here: every
+        // reciprocal is finite and nonzero).
+        #[allow(unsafe_code)]
+        // SAFETY: `t_max` is 8 f32, one unaligned 256-bit load.
+        let tmax = unsafe { _mm256_loadu_ps(t_max.as_ptr()) };
+        let (mut near, mut far) = (set(t_min), tmax);
+        for a in 0..3 {
+            let t0 = mul(sub(set(bvh.root_lo[a]), ov[a]), iv[a]);
+            let t1 = mul(sub(set(bvh.root_hi[a]), ov[a]), iv[a]);
+            near = _mm256_max_ps(near, _mm256_min_ps(t0, t1));
+            far = _mm256_min_ps(far, _mm256_max_ps(t0, t1));
+        }
+        let live = bits(_mm256_cmp_ps::<_CMP_LE_OQ>(
+            near,
+            mul(far, set(1.000_000_4)),
+        )) & active;
+        let mut p = PacketPre {
+            neg: [false; 3],
+            o_near: [0.0; 3],
+            o_far: [0.0; 3],
+            inv_min: [0.0; 3],
+            inv_max: [0.0; 3],
+            o: ov,
+            inv: iv,
+        };
+        if live == 0 {
+            return Some((p, 0));
+        }
+        // Lanes of the live rays as a mask, for the bounds over them.
+        let sel = |lo: i32| _mm_setr_epi32(lo, lo << 1, lo << 2, lo << 3);
+        let b = _mm_set1_epi32(live as i32);
+        let lane = |s: __m128i| _mm_cmpeq_epi32(_mm_and_si128(b, s), s);
+        let lanes = _mm256_castsi256_ps(_mm256_set_m128i(lane(sel(16)), lane(sel(1))));
+        // Horizontal min and max of the eight lanes.
+        let hmin = |v: __m256| {
+            let v = _mm256_min_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+            let v = _mm256_min_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+            _mm256_cvtss_f32(_mm256_min_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v)))
+        };
+        let hmax = |v: __m256| {
+            let v = _mm256_max_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+            let v = _mm256_max_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+            _mm256_cvtss_f32(_mm256_max_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v)))
+        };
+        let neg_inf = set(f32::NEG_INFINITY);
+        for a in 0..3 {
+            let neg = bits(_mm256_cmp_ps::<_CMP_LT_OQ>(iv[a], _mm256_setzero_ps())) & live;
+            if neg != 0 && neg != live {
+                return None;
+            }
+            p.neg[a] = neg != 0;
+            let o_min = hmin(_mm256_blendv_ps(inf, ov[a], lanes));
+            let o_max = hmax(_mm256_blendv_ps(neg_inf, ov[a], lanes));
+            p.inv_min[a] = hmin(_mm256_blendv_ps(inf, iv[a], lanes));
+            p.inv_max[a] = hmax(_mm256_blendv_ps(neg_inf, iv[a], lanes));
+            (p.o_near[a], p.o_far[a]) = if p.neg[a] {
+                (o_min, o_max)
+            } else {
+                (o_max, o_min)
+            };
+        }
+        Some((p, live))
+    }
+
+    /// The packet against a node's eight boxes: bit i set when some ray of the packet may
+    /// enter slot i within [t_min, t_far] (never unset where a ray's own `slab8` sets it);
+    /// `tn` gets lower bounds of the rays' entry distances.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn slab8(&self, n: &Node8, t_min: f32, t_far: f32, tn: &mut [f32; WIDTH]) -> u32 {
+        use std::arch::x86_64::*;
+        #[allow(unsafe_code)]
+        // SAFETY: an axis row [Vec4; 2] is 8 contiguous f32; unaligned loads ask nothing more.
+        let ld = |v: &[Vec4; 2]| unsafe { _mm256_loadu_ps(v.as_ptr().cast::<f32>()) };
+        let (sub, mul, blend, set) = (
+            _mm256_sub_ps,
+            _mm256_mul_ps,
+            _mm256_blendv_ps,
+            _mm256_set1_ps,
+        );
+        let side = |a: usize| {
+            let (np, fp) = if self.neg[a] {
+                (&n.hi[a], &n.lo[a])
+            } else {
+                (&n.lo[a], &n.hi[a])
+            };
+            let (lo, hi) = (set(self.inv_min[a]), set(self.inv_max[a]));
+            // blendv takes its second operand where the difference is negative.
+            let x = sub(ld(np), set(self.o_near[a]));
+            let y = sub(ld(fp), set(self.o_far[a]));
+            (mul(x, blend(lo, hi, x)), mul(y, blend(hi, lo, y)))
+        };
+        let (nx, fx) = side(0);
+        let (ny, fy) = side(1);
+        let (nz, fz) = side(2);
+        let near = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, set(t_min)));
+        let far = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, set(t_far)));
+        let far = mul(far, set(1.000_000_4));
+        #[allow(unsafe_code)]
+        // SAFETY: `tn` is 8 f32, exactly one unaligned 256-bit store.
+        unsafe {
+            _mm256_storeu_ps(tn.as_mut_ptr(), near)
+        };
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+    }
+
+    /// Bit i set when ray i's own slab test (`slab8_avx`'s operations in its order, lane i)
+    /// enters slot `s` of `n` within [t_min, t_best[i]].
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn rays_entering(&self, n: &Node8, s: usize, t_min: f32, t_best: &[f32; WIDTH]) -> u8 {
+        use std::arch::x86_64::*;
+        #[allow(unsafe_code)]
+        // SAFETY: each row is 8 f32, one unaligned 256-bit load.
+        let ld = |v: &[f32; WIDTH]| unsafe { _mm256_loadu_ps(v.as_ptr()) };
+        let (sub, mul, set) = (_mm256_sub_ps, _mm256_mul_ps, _mm256_set1_ps);
+        let (h, l) = (s / 4, s % 4);
+        let slab = |a: usize| {
+            let (np, fp) = if self.neg[a] {
+                (n.hi[a][h][l], n.lo[a][h][l])
+            } else {
+                (n.lo[a][h][l], n.hi[a][h][l])
+            };
+            let (o, inv) = (self.o[a], self.inv[a]);
+            (mul(sub(set(np), o), inv), mul(sub(set(fp), o), inv))
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let near = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, set(t_min)));
+        let far = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, ld(t_best)));
+        let far = mul(far, set(1.000_000_4));
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u8
+    }
 }
 
 #[cfg(test)]
@@ -1021,6 +1425,180 @@ mod tests {
         }
     }
 
+    /// Packets of the eight rays `rays[k..k + 8]` under every `active` mask in `masks`: each
+    /// traced ray gets the single-ray t bit for bit (and a triangle hit at that t), its
+    /// t_max lowered to it; rays left out get nothing and keep their t_max. Returns how
+    /// many rays were compared.
+    fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8]) -> usize {
+        let mut compared = 0;
+        for (p, chunk) in rays.chunks_exact(WIDTH).enumerate() {
+            let o: [Vec3A; WIDTH] = std::array::from_fn(|i| chunk[i].origin.into());
+            let d: [Vec3A; WIDTH] = std::array::from_fn(|i| chunk[i].direction.into());
+            for &active in masks {
+                let mut limits = [f32::INFINITY; WIDTH];
+                limits[3] = 7.5; // one ray with a finite limit
+                let mut t_packet = limits;
+                let got = bvh.closest_hit8(&o, &d, active, t_min, &mut t_packet);
+                for i in 0..WIDTH {
+                    let want = if active & (1 << i) != 0 {
+                        bvh.closest_hit(o[i], d[i], t_min, limits[i])
+                    } else {
+                        None
+                    };
+                    match (got[i], want) {
+                        (None, None) => {}
+                        (Some(g), Some(w)) => {
+                            assert_eq!(
+                                g.t.to_bits(),
+                                w.t.to_bits(),
+                                "packet {p} ray {i} mask {active:#x}"
+                            );
+                            if g.triangle != w.triangle {
+                                // A tie: the other triangle must be hit at that very t.
+                                let k = bvh
+                                    .ids
+                                    .iter()
+                                    .position(|&id| id == g.triangle)
+                                    .expect("a stored id");
+                                assert_eq!(
+                                    bvh.tri(k).hit(chunk[i].origin, chunk[i].direction),
+                                    Some(g.t),
+                                    "packet {p} ray {i}: triangle {} not hit at {}",
+                                    g.triangle,
+                                    g.t
+                                );
+                            }
+                        }
+                        _ => panic!(
+                            "packet {p} ray {i} mask {active:#x}: {:?} vs single {want:?}",
+                            got[i]
+                        ),
+                    }
+                    let want_t = want.map_or(limits[i], |h| h.t);
+                    assert_eq!(
+                        t_packet[i].to_bits(),
+                        want_t.to_bits(),
+                        "packet {p} ray {i}: t_max"
+                    );
+                }
+                // The portable fallback (single rays) agrees too.
+                let mut t_singles = limits;
+                let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
+                assert_eq!(
+                    t_singles.map(f32::to_bits),
+                    t_packet.map(f32::to_bits),
+                    "packet {p}"
+                );
+                assert_eq!(
+                    singles.map(|h| h.map(|h| h.t)),
+                    got.map(|h| h.map(|h| h.t)),
+                    "packet {p}"
+                );
+                compared += active.count_ones() as usize;
+            }
+        }
+        compared
+    }
+
+    /// Primary rays of a pinhole camera at `eye` looking at `at`, in 4x2 pixel tiles (the
+    /// bench's packets): `n` x `n` pixels, n a multiple of 4, spanning `fov` radians.
+    fn pinhole_tiles(eye: Vec3, at: Vec3, n: usize, fov: f32) -> Vec<Ray> {
+        camera_tiles(eye, at, n, fov, 0.0)
+    }
+
+    /// `pinhole_tiles` with origins spread over the screen too (`spread` = 1: a screen as
+    /// wide as the view at distance 1), so a packet's origins differ.
+    fn camera_tiles(eye: Vec3, at: Vec3, n: usize, fov: f32, spread: f32) -> Vec<Ray> {
+        let f = (at - eye).normalize();
+        let r = f.cross(Vec3::Y).normalize();
+        let u = r.cross(f);
+        let h = (fov * 0.5).tan();
+        let mut rays = Vec::new();
+        for ty in (0..n).step_by(2) {
+            for tx in (0..n).step_by(4) {
+                for k in 0..WIDTH {
+                    let (i, j) = (tx + (k & 3), ty + (k >> 2));
+                    let x = (2.0 * (i as f32 + 0.5) / n as f32 - 1.0) * h;
+                    let y = (1.0 - 2.0 * (j as f32 + 0.5) / n as f32) * h;
+                    let o = eye + (x * r + y * u) * spread;
+                    rays.push(Ray::new(o, (f + x * r + y * u).normalize()));
+                }
+            }
+        }
+        rays
+    }
+
+    const MASKS: [u8; 5] = [0xff, 0x01, 0x80, 0x5a, 0x00];
+
+    #[test]
+    fn packets_agree_with_single_rays_on_random_meshes() {
+        for (n, seed) in [(1, 7), (9, 1), (2000, 13), (20_000, 17)] {
+            let (pos, tris) = random_mesh(n, seed);
+            let bvh = build_checked(&pos, &tris);
+            let mut compared = 0;
+            // Coherent tiles from pinholes on every side (all eight sign octants).
+            for eye in [
+                Vec3::new(0.3, 0.4, 6.0),
+                Vec3::new(-5.0, -4.0, -3.0),
+                Vec3::new(4.0, -5.0, 2.0),
+                Vec3::new(-0.2, 6.0, -4.0),
+            ] {
+                let rays = pinhole_tiles(eye, Vec3::new(0.1, -0.2, 0.05), 32, 0.9);
+                compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+                // Origins differing within a packet (the origin bounds matter), and nearly
+                // parallel rays (the reciprocal bounds collapse).
+                for (fov, spread) in [(0.9, 2.0), (0.01, 400.0)] {
+                    let rays = camera_tiles(eye, Vec3::new(-0.1, 0.2, 0.0), 32, fov, spread);
+                    compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+                }
+                // A camera inside the mesh's box, with t_min > 0.
+                let inside = pinhole_tiles(eye * 0.05, Vec3::ZERO, 16, 1.2);
+                compared += assert_packets_agree(&bvh, &inside, 0.3, &MASKS);
+            }
+            // Incoherent packets: random origins and directions, mixed signs.
+            let rays = rays_toward(Vec3::ZERO, 2.0, 1024, 77 + seed);
+            compared += assert_packets_agree(&bvh, &rays, 0.0, &MASKS);
+            // Axis-parallel rays (zero direction components) amid coherent ones.
+            let mut mixed = pinhole_tiles(Vec3::new(0.0, 0.0, 6.0), Vec3::ZERO, 8, 0.6);
+            for (k, r) in mixed.iter_mut().enumerate().step_by(5) {
+                *r = Ray::new(r.origin + Vec3::new(0.01 * k as f32, 0.0, 0.0), Vec3::NEG_Z);
+            }
+            compared += assert_packets_agree(&bvh, &mixed, 0.0, &MASKS);
+            assert!(compared > 1000, "{compared} rays compared");
+        }
+    }
+
+    #[test]
+    fn packets_on_empty_and_one_triangle_meshes() {
+        let rays = pinhole_tiles(Vec3::new(0.2, 0.3, 3.0), Vec3::new(0.3, 0.3, 0.0), 8, 0.8);
+        let empty = build_checked(&[], &[]);
+        let o: [Vec3A; WIDTH] = std::array::from_fn(|i| rays[i].origin.into());
+        let d: [Vec3A; WIDTH] = std::array::from_fn(|i| rays[i].direction.into());
+        let mut t_max = [f32::INFINITY; WIDTH];
+        assert_eq!(
+            empty.closest_hit8(&o, &d, 0xff, 0.0, &mut t_max),
+            [None; WIDTH]
+        );
+        assert_eq!(t_max, [f32::INFINITY; WIDTH]);
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let one = build_checked(&pos, &[[0, 1, 2]]);
+        assert_packets_agree(&one, &rays, 0.0, &MASKS);
+        // The middle rays of the tiles do hit the triangle.
+        let hits: usize = rays
+            .chunks_exact(WIDTH)
+            .map(|c| {
+                let o: [Vec3A; WIDTH] = std::array::from_fn(|i| c[i].origin.into());
+                let d: [Vec3A; WIDTH] = std::array::from_fn(|i| c[i].direction.into());
+                let mut t = [f32::INFINITY; WIDTH];
+                one.closest_hit8(&o, &d, 0xff, 0.0, &mut t)
+                    .iter()
+                    .flatten()
+                    .count()
+            })
+            .sum();
+        assert!(hits > 0 && hits < rays.len(), "{hits} hits");
+    }
+
     #[test]
     fn shared_meshes_agree_with_brute_force() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
@@ -1054,6 +1632,13 @@ mod tests {
                 &bvh,
                 &rays_toward(b.center(), radius, rays, 41),
             );
+            // Packets: pinhole tiles from two sides, and the incoherent rays.
+            for eye in [Vec3::new(0.3, 0.5, 3.0), Vec3::new(-2.0, -1.5, -2.5)] {
+                let tiles = pinhole_tiles(b.center() + eye * radius, b.center(), 64, 0.8);
+                assert_packets_agree(&bvh, &tiles, 0.0, &MASKS);
+            }
+            let mixed = rays_toward(b.center(), radius, 512, 43);
+            assert_packets_agree(&bvh, &mixed, 0.0, &MASKS);
         }
     }
 }

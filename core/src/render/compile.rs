@@ -194,6 +194,35 @@ impl CompiledScene {
         self.intersect_scene(ray, t_min, t_max)
     }
 
+    /// `intersect` for eight rays at once, for those whose bit is set in `active` (the others
+    /// get None): a one-mesh scene traces them as a packet (`TriangleBvh::closest_hit8`,
+    /// the same t as `intersect` bit for bit), any other scene one by one.
+    #[inline]
+    pub fn intersect8(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
+        if let Some(i) = self.single_mesh
+            && let Some(o) = self.objects.get(i as usize)
+            && let Shape::Mesh(m) = &o.shape
+        {
+            let (org, dir): ([Vec3A; 8], [Vec3A; 8]) = match &o.xf {
+                // Direction deliberately not renormalised, as in `mesh_hit`.
+                Some(xf) => (
+                    std::array::from_fn(|k| xf.object_from_world.transform_point3(rays[k].origin).into()),
+                    std::array::from_fn(|k| xf.object_from_world.transform_vector3(rays[k].direction).into()),
+                ),
+                None => (
+                    std::array::from_fn(|k| rays[k].origin.into()),
+                    std::array::from_fn(|k| rays[k].direction.into()),
+                ),
+            };
+            let mut t = [t_max; 8];
+            let hits = m.accel.closest_hit8(&org, &dir, active, t_min, &mut t);
+            return hits.map(|h| h.map(|h| Hit { t: h.t, object: i, prim: h.triangle }));
+        }
+        std::array::from_fn(|k| {
+            if active & (1 << k) != 0 { self.intersect(&rays[k], t_min, t_max) } else { None }
+        })
+    }
+
     /// A mesh instance's closest hit: the ray to object space (as `Vec3`s, whose components
     /// the matrix product reads one at a time), then the mesh BVH, which takes 16-byte vectors.
     #[inline(always)]
