@@ -84,38 +84,52 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
     // loop does; the same rays (two rows made as above), the same t per pixel.
     let packet_frame = |buf: &mut Vec<f32>| {
         let rays = compiled.camera.pixel_rays(w, h);
-        let new_bufs = || (Vec::with_capacity(w as usize), Vec::with_capacity(w as usize));
-        buf.par_chunks_mut(2 * w as usize).enumerate().with_min_len(8).for_each_init(new_bufs, |(top, bottom), (pair, out)| {
-            let row = 2 * pair as u32;
-            rays.row(row).fill(top);
-            let two = out.len() > w as usize;
-            if two {
-                rays.row(row + 1).fill(bottom);
-            } else {
-                bottom.clear();
-                bottom.extend_from_slice(top);
-            }
-            let (out_top, out_bottom) = out.split_at_mut(w as usize);
-            for x in (0..w as usize).step_by(4) {
-                let n = (w as usize - x).min(4);
-                let ray = |k: usize| {
-                    let row = if k < 4 { &*top } else { &*bottom };
-                    row[x + (k & 3).min(n - 1)]
-                };
-                let packet: [Ray; 8] = std::array::from_fn(ray);
-                let cols = (1u8 << n) - 1;
-                let active = if two { cols | (cols << 4) } else { cols };
-                let hits = compiled.intersect8(&packet, active, t_min, f32::INFINITY);
-                for k in 0..n {
-                    out_top[x + k] = hits[k].map_or(f32::INFINITY, |hit| hit.t);
-                    if two {
-                        out_bottom[x + k] = hits[4 + k].map_or(f32::INFINITY, |hit| hit.t);
+        let new_bufs = || {
+            (
+                Vec::with_capacity(w as usize),
+                Vec::with_capacity(w as usize),
+            )
+        };
+        buf.par_chunks_mut(2 * w as usize)
+            .enumerate()
+            .with_min_len(8)
+            .for_each_init(new_bufs, |(top, bottom), (pair, out)| {
+                let row = 2 * pair as u32;
+                rays.row(row).fill(top);
+                let two = out.len() > w as usize;
+                if two {
+                    rays.row(row + 1).fill(bottom);
+                } else {
+                    bottom.clear();
+                    bottom.extend_from_slice(top);
+                }
+                let (out_top, out_bottom) = out.split_at_mut(w as usize);
+                for x in (0..w as usize).step_by(4) {
+                    let n = (w as usize - x).min(4);
+                    let ray = |k: usize| {
+                        let row = if k < 4 { &*top } else { &*bottom };
+                        row[x + (k & 3).min(n - 1)]
+                    };
+                    let packet: [Ray; 8] = std::array::from_fn(ray);
+                    let cols = (1u8 << n) - 1;
+                    let active = if two { cols | (cols << 4) } else { cols };
+                    let hits = compiled.intersect8(&packet, active, t_min, f32::INFINITY);
+                    for k in 0..n {
+                        out_top[x + k] = hits[k].map_or(f32::INFINITY, |hit| hit.t);
+                        if two {
+                            out_bottom[x + k] = hits[4 + k].map_or(f32::INFINITY, |hit| hit.t);
+                        }
                     }
                 }
-            }
-        });
+            });
     };
-    let run_frame = |buf: &mut Vec<f32>| if b.packets { packet_frame(buf) } else { frame(buf) };
+    let run_frame = |buf: &mut Vec<f32>| {
+        if b.packets {
+            packet_frame(buf)
+        } else {
+            frame(buf)
+        }
+    };
     if b.packets {
         println!("mode: PACKETS, 4x2 pixel tiles traced as 8-ray packets");
     }
@@ -145,7 +159,9 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         (w as f64 * h as f64) / best / 1e6
     );
     let mode = if b.packets { " mode=packets" } else { "" };
-    println!("BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}");
+    println!(
+        "BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}"
+    );
     Ok(())
 }
 
