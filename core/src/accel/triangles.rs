@@ -1568,6 +1568,39 @@ mod tests {
         }
     }
 
+    /// Pins the guard the result tests cannot see (without it, loose bounds only slow the
+    /// traversal down): a packet whose rays meeting the mesh differ in direction sign on an
+    /// axis, or have a zero direction component, is not traced as a packet.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
+        if !has_avx() {
+            crate::test_support::skip_note("no AVX here: packets always go one by one");
+            return;
+        }
+        let (pos, tris) = random_mesh(200, 3);
+        let bvh = build_checked(&pos, &tris);
+        let eye = Vec3::new(0.0, 0.0, 6.0);
+        // Eight rays toward points near (0.5, 0.5, 0): every one meets the mesh's box.
+        let toward = |k: usize| Vec3::new(0.5 + 0.01 * k as f32, 0.5 - 0.01 * k as f32, 0.0);
+        let packet = |dirs: [Vec3; WIDTH]| {
+            let o = [Vec3A::from(eye); WIDTH];
+            let d: [Vec3A; WIDTH] = dirs.map(Vec3A::from);
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked above.
+            unsafe { PacketPre::new(&o, &d, 0xff, &bvh, 0.0, &[f32::INFINITY; WIDTH]) }
+                .map(|(_, live)| live)
+        };
+        let coherent: [Vec3; WIDTH] = std::array::from_fn(|k| toward(k) - eye);
+        assert_eq!(packet(coherent), Some(0xff), "a coherent tile is a packet");
+        let mut mixed = coherent;
+        mixed[3].x = -mixed[3].x;
+        assert_eq!(packet(mixed), None, "one ray runs toward -x");
+        let mut zero = coherent;
+        zero[5].y = 0.0;
+        assert_eq!(packet(zero), None, "one ray is parallel to the xz plane");
+    }
+
     #[test]
     fn packets_on_empty_and_one_triangle_meshes() {
         let rays = pinhole_tiles(Vec3::new(0.2, 0.3, 3.0), Vec3::new(0.3, 0.3, 0.0), 8, 0.8);
