@@ -1,6 +1,8 @@
 //! The format extensions (Box, Union, Intersection, Subtraction) and the slides' shorthand:
 //! how they read, how they are written back, and the errors they give with their location.
 
+mod common;
+use common::{Rng, mutate};
 use std::path::Path;
 
 use glam::Vec3;
@@ -242,18 +244,6 @@ fn transform_ops_in_braces_read_as_on_the_slides_and_are_written_bare() {
 }
 
 /// Deterministic xorshift, so failures reproduce.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 #[test]
 fn no_mutated_csg_scene_panics_and_clean_ones_round_trip() {
@@ -268,25 +258,7 @@ fn no_mutated_csg_scene_panics_and_clean_ones_round_trip() {
     let mut rng = Rng(0x2545_f491_4f6c_dd1d);
     let mut clean = 0;
     for _ in 0..2000 {
-        let mut w = words.clone();
-        for _ in 0..1 + rng.below(2) {
-            match rng.below(3) {
-                0 if !w.is_empty() => {
-                    let i = rng.below(w.len());
-                    w.remove(i);
-                }
-                1 => {
-                    let i = rng.below(w.len() + 1);
-                    w.insert(i, extra[rng.below(extra.len())]);
-                }
-                _ if !w.is_empty() => {
-                    let i = rng.below(w.len());
-                    w[i] = words[rng.below(words.len())];
-                }
-                _ => {}
-            }
-        }
-        let text = w.join(" ");
+        let text = mutate(&words, &extra, 2, &mut rng);
         let out = parse(&text);
         let Some(scene) = out.scene else {
             assert!(out.diagnostics.has_errors(), "no scene and no error for {text}");

@@ -1,6 +1,8 @@
 //! The parser on broken input: every kind of error comes back as a value with its exact
 //! line:column, several errors are reported from one pass, and no input panics.
 
+mod common;
+use common::{Rng, mutate};
 use tracelab_core::{MeshCache, ParseOutcome, Severity, parse_scene};
 
 const HEAD: &str = "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 -1\n    up 0 1 0\n    size 5\n}\n\
@@ -226,18 +228,6 @@ fn deep_nesting_parses_renders_writes_and_drops_without_overflow() {
 }
 
 /// Deterministic xorshift, so failures reproduce.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 #[test]
 fn no_input_panics_the_parser() {
@@ -248,25 +238,7 @@ fn no_input_panics_the_parser() {
     let extra = ["{", "}", "-", "1e999", "nan", "Group", "Transform", "numObjects", "MaterialIndex", "0", "é", "\u{0}", "TriangleMesh", "obj_file"];
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     for _ in 0..3000 {
-        let mut w: Vec<&str> = words.clone();
-        for _ in 0..1 + rng.below(6) {
-            match rng.below(3) {
-                0 if !w.is_empty() => {
-                    let i = rng.below(w.len());
-                    w.remove(i);
-                }
-                1 => {
-                    let i = rng.below(w.len() + 1);
-                    w.insert(i, extra[rng.below(extra.len())]);
-                }
-                _ if !w.is_empty() => {
-                    let i = rng.below(w.len());
-                    w[i] = words[rng.below(words.len())];
-                }
-                _ => {}
-            }
-        }
-        let text = w.join(" ");
+        let text = mutate(&words, &extra, 6, &mut rng);
         let out = parse(&text);
         // Whatever came back must be usable: render and write it if it parsed.
         if let Some(scene) = out.scene {
