@@ -261,6 +261,11 @@ impl TracelabApp {
         }
     }
 
+    /// The images the view drew in the last frame, with the pixels on screen.
+    pub fn shown(&self) -> Vec<crate::ui::viewport::Shown> {
+        self.viewport.shown()
+    }
+
     /// Starts (or keeps) the render for the current document and view.
     pub fn request_render(&mut self, size: (u32, u32)) {
         let settings = Viewport::settings(&self.view, size);

@@ -548,3 +548,56 @@ fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
         "an operand, not the CSG node"
     );
 }
+
+/// The pixels the view drew (the uploaded texture), as RGB, for the single view.
+fn on_screen(h: &Harness<'static, TracelabApp>) -> Vec<u8> {
+    let shown = h.state().shown();
+    assert_eq!(shown.len(), 1, "one image in the single view");
+    shown[0].rgb8()
+}
+
+#[test]
+fn the_picture_on_screen_follows_the_normal_switch_and_shade_back() {
+    // Bug: the texture was keyed by document generation and frame version; a re-render of
+    // the same generation for another rule reached the same version and never replaced it.
+    let path = temp_dir("screen-switch").join("sphere.txt");
+    std::fs::write(&path, SPHERE_SCENE.replace("OP", "Scale 1 0.2 1")).expect("write");
+    let mut h = harness(Some(path), (40, 40));
+    h.get_by_label("Normals").click();
+    h.step();
+    settle(&mut h);
+    let correct = on_screen(&h);
+    let rendered = |h: &Harness<'static, TracelabApp>| {
+        h.state().worker.with_published(|p| {
+            p.expect("rendered").frames[0]
+                .lock()
+                .rgb8(View::Normals, (0.0, 1.0))
+        })
+    };
+    assert_eq!(correct, rendered(&h), "the screen shows the render");
+    h.get_by_label("Incorrect M").click();
+    h.step();
+    settle(&mut h);
+    let incorrect = on_screen(&h);
+    assert_ne!(correct, incorrect, "Incorrect M changed nothing on screen");
+    assert_eq!(incorrect, rendered(&h));
+    h.get_by_label("Correct (M^-1)^T").click();
+    h.step();
+    settle(&mut h);
+    assert_eq!(on_screen(&h), correct, "Correct restores the picture");
+}
+
+#[test]
+fn shade_back_changes_the_picture_of_an_inside_view() {
+    let Some(scene) = shared_scene("scene2_05_inside_sphere.txt") else {
+        return;
+    };
+    let mut h = harness(Some(scene), (40, 40));
+    settle(&mut h);
+    let before = on_screen(&h);
+    h.get_by_label("shade back").click();
+    h.step();
+    settle(&mut h);
+    assert!(h.state().view.shade_back);
+    assert_ne!(before, on_screen(&h), "shade back changed nothing on screen");
+}

@@ -92,15 +92,54 @@ pub struct Pick {
     pub row: u32,
 }
 
-/// (generation, frame version, view, depth range bits): what a texture holds.
+/// (render request, frame version, view, depth range bits): what a texture holds. The
+/// request, not the document generation, names the render: a change of normal rule, shade
+/// back or size re-renders the same generation into new frames whose version counters
+/// start again, so a key by generation once kept the old picture on screen.
 type UploadKey = (u64, u64, View, (u32, u32));
+
+/// One image drawn in the view: a texture, the screen rectangle it filled and the part of
+/// the texture shown there (split mode shows a part of each rule's image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drawn {
+    texture: usize,
+    pub rect: egui::Rect,
+    pub uv: egui::Rect,
+}
+
+/// Pixels the view put on screen: what the texture held when it was drawn.
+#[derive(Clone, Debug)]
+pub struct Shown {
+    pub rect: egui::Rect,
+    pub uv: egui::Rect,
+    pub image: std::sync::Arc<egui::ColorImage>,
+}
+
+impl Shown {
+    /// The image as RGB bytes, rows from the top (the layout of `Frame::rgb8`).
+    pub fn rgb8(&self) -> Vec<u8> {
+        self.image
+            .pixels
+            .iter()
+            .flat_map(|c| [c.r(), c.g(), c.b()])
+            .collect()
+    }
+
+    pub fn size(&self) -> [usize; 2] {
+        self.image.size
+    }
+}
 
 /// Texture state: what is on the GPU, so unchanged pixels are not uploaded again.
 #[derive(Default)]
 pub struct Viewport {
     textures: Vec<Option<egui::TextureHandle>>,
-    /// Per texture: (generation, frame version, view, depth range) last uploaded.
+    /// Per texture: (request, frame version, view, depth range) last uploaded.
     uploaded: Vec<Option<UploadKey>>,
+    /// Per texture: the pixels last uploaded, so tests can read what the view shows.
+    images: Vec<Option<std::sync::Arc<egui::ColorImage>>>,
+    /// What the last frame drew: each texture, where, and which part of it.
+    drawn: Vec<Drawn>,
     /// Size of the image shown, in pixels.
     pub shown_size: (u32, u32),
     /// The pixel being inspected, marked in every image.
@@ -188,6 +227,13 @@ impl Viewport {
         let caption = if n > 1.0 { 18.0 } else { 0.0 };
         let w = (avail.x / n - 4.0).max(8.0) * pixels_per_point;
         let h = (avail.y - caption).max(8.0) * pixels_per_point;
+        if n > 1.0 {
+            // Several cells side by side are tall and narrow; the camera spans the larger
+            // side and crops the other, so a non-square cell would cut the scene off at the
+            // sides. Square cells show all of it, as the course's square images do.
+            let side = w.min(h) as u32;
+            return (side, side);
+        }
         (w as u32, h as u32)
     }
 
@@ -201,6 +247,7 @@ impl Viewport {
         let cells = s.cells();
         let ctx = ui.ctx().clone();
         let mut pick = None;
+        self.drawn.clear();
         worker.with_published(|p| {
             let Some(p) = p else {
                 ui.label("Rendering…");
@@ -261,8 +308,11 @@ impl Viewport {
                         egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
                     ui.painter()
                         .image(tex.id(), left, luv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn { texture: tex_i, rect: left, uv: luv });
                     if let Some(o) = other {
                         ui.painter().image(o.id(), right, ruv, egui::Color32::WHITE);
+                        let texture = self.tex_index(1, view);
+                        self.drawn.push(Drawn { texture, rect: right, uv: ruv });
                     }
                     ui.painter().vline(
                         xs,
@@ -276,6 +326,7 @@ impl Viewport {
                     }
                 } else {
                     ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn { texture: tex_i, rect, uv });
                 }
                 let _ = ci;
                 if let Some((mx, my)) = self.marker {
@@ -310,6 +361,18 @@ impl Viewport {
         pick
     }
 
+    /// The images the last frame drew, in drawing order, with the pixels their textures
+    /// held: what the user sees, not what the renderer has.
+    pub fn shown(&self) -> Vec<Shown> {
+        self.drawn
+            .iter()
+            .filter_map(|d| {
+                let image = self.images.get(d.texture)?.clone()?;
+                Some(Shown { rect: d.rect, uv: d.uv, image })
+            })
+            .collect()
+    }
+
     fn tex_index(&self, frame: usize, view: View) -> usize {
         frame * 3
             + match view {
@@ -337,9 +400,10 @@ impl Viewport {
             if self.textures.len() <= i {
                 self.textures.resize_with(i + 1, || None);
                 self.uploaded.resize(i + 1, None);
+                self.images.resize(i + 1, None);
             }
             let depth_key = (s.depth.0.to_bits(), s.depth.1.to_bits());
-            let key = Some((p.job.generation, frame.version(), view, depth_key));
+            let key = Some((p.job.request, frame.version(), view, depth_key));
             if self.uploaded[i] == key {
                 continue;
             }
@@ -350,7 +414,11 @@ impl Viewport {
             if w == 0 || h == 0 {
                 continue;
             }
-            let image = egui::ColorImage::from_rgba_unmultiplied([w as usize, h as usize], &rgba);
+            let image = std::sync::Arc::new(egui::ColorImage::from_rgba_unmultiplied(
+                [w as usize, h as usize],
+                &rgba,
+            ));
+            self.images[i] = Some(image.clone());
             match &mut self.textures[i] {
                 Some(t) => t.set(image, egui::TextureOptions::NEAREST),
                 slot => {
