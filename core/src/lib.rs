@@ -16,7 +16,7 @@ pub use render::{
 };
 pub use scene::{
     DEFAULT_MATERIAL_COLOR,
-    Background, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
+    Anchor, Background, Comments, SceneComments, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
     NodeKind, Scene, TransformOp,
 };
 
