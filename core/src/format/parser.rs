@@ -1108,6 +1108,10 @@ impl<'a> Parser<'a> {
         let result = resolve_obj_path(name, self.base_dir).and_then(|path| self.cache.load(&path));
         match result {
             Ok(mesh) => {
+                if let Some(dir) = self.base_dir.filter(|d| !d.join(name).is_file()) {
+                    let dir = if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() };
+                    self.warn(off, format!("OBJ file \"{name}\" is not in the scene's folder ({dir}); using the one in the current folder"));
+                }
                 if mesh.triangle_count() == 0 {
                     self.warn(off, format!("OBJ file \"{name}\" has no triangles"));
                 }
