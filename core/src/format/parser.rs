@@ -650,7 +650,7 @@ impl<'a> Parser<'a> {
                 (TokKind::Word, "numLights") => {
                     let c = self.comments_here();
                     if !c.is_empty() {
-                        comments.inner.insert(Anchor::Field("numLights".into()), c);
+                        comments.inner.entry(Anchor::Field("numLights".into())).or_default().extend(c);
                     }
                     declared = self.expect_count("numLights")
                 }
@@ -725,7 +725,7 @@ impl<'a> Parser<'a> {
                 (TokKind::Word, "numMaterials") => {
                     let c = self.comments_here();
                     if !c.is_empty() {
-                        comments.inner.insert(Anchor::Field("numMaterials".into()), c);
+                        comments.inner.entry(Anchor::Field("numMaterials".into())).or_default().extend(c);
                     }
                     declared = self.expect_count("numMaterials")
                 }
@@ -809,7 +809,7 @@ impl<'a> Parser<'a> {
                                     "numObjects" => {
                                         let c = self.comments_here();
                                         if !c.is_empty() {
-                                            graph.node_mut(parent).comments.inner.insert(Anchor::Field("numObjects".into()), c);
+                                            graph.node_mut(parent).comments.inner.entry(Anchor::Field("numObjects".into())).or_default().extend(c);
                                         }
                                         if declared.is_some() {
                                             self.error(t.start, "numObjects is given twice in this Group");
@@ -878,7 +878,7 @@ impl<'a> Parser<'a> {
                                     match stack.last_mut() {
                                         Some(Frame::Transform { ops, has_child: false, .. }) => {
                                             if !c.is_empty() {
-                                                graph.node_mut(parent).comments.inner.insert(Anchor::Op(ops.len()), c);
+                                                graph.node_mut(parent).comments.inner.entry(Anchor::Op(ops.len())).or_default().extend(c);
                                             }
                                             ops.push((op, t.start))
                                         }
