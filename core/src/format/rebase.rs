@@ -38,10 +38,12 @@ pub fn rebase_mesh_paths(scene: &mut Scene, from_dir: &Path, to_dir: &Path) -> V
         // Relative if one exists and reaches the file (a symlinked folder can defeat the
         // lexical `..`); else absolute. Either must be one word of the scene format.
         let relative = relative_path(&normalize(&target), &to).filter(|r| to.join(r).is_file());
-        let written = [relative, Some(target)]
+        let relative = relative.and_then(|r| portable(&r));
+        let absolute = target.to_str().map(str::to_string);
+        let written = [relative, absolute]
             .into_iter()
             .flatten()
-            .find_map(|p| Some(p.to_str()?.to_string()).filter(|s| is_word(s)));
+            .find(|s| is_word(s));
         match written {
             Some(w) => *obj_file = w,
             None => warnings.push(format!(
@@ -51,6 +53,13 @@ pub fn rebase_mesh_paths(scene: &mut Scene, from_dir: &Path, to_dir: &Path) -> V
         }
     }
     warnings
+}
+
+/// A relative path with `/` between its parts, which every platform reads, so a scene saved
+/// on Windows still opens elsewhere.
+fn portable(rel: &Path) -> Option<String> {
+    let parts: Option<Vec<&str>> = rel.components().map(|c| c.as_os_str().to_str()).collect();
+    parts.map(|p| p.join("/"))
 }
 
 /// Whether the lexer reads `s` back as a single word.
@@ -131,6 +140,12 @@ mod tests {
             Some("../../bunny.obj")
         );
         assert_eq!(normalize(Path::new("/a/b/../c/./d")), Path::new("/a/c/d"));
+        // No common root (on Windows: another drive): no relative path, so it is written absolute.
+        assert_eq!(rel("/a/bunny.obj", "b"), None);
+        assert_eq!(
+            portable(Path::new("../x/y.obj")).as_deref(),
+            Some("../x/y.obj")
+        );
     }
 
     fn scene_with_meshes(names: &[&str]) -> Scene {
