@@ -8,13 +8,18 @@ use tracelab_core::{MeshCache, Scene, Severity, load_scene, parse_scene, write_s
 fn parse(text: &str) -> (Scene, Vec<String>) {
     let out = parse_scene(text.as_bytes(), "c.txt", None, &mut MeshCache::new());
     let warnings = out.diagnostics.warnings().map(|d| d.to_string()).collect();
-    let scene = out.scene.unwrap_or_else(|| panic!("does not parse:\n{}", out.diagnostics));
+    let scene = out
+        .scene
+        .unwrap_or_else(|| panic!("does not parse:\n{}", out.diagnostics));
     (scene, warnings)
 }
 
 /// Every comment line of `text`, trimmed, in file order.
 fn comment_lines(text: &str) -> Vec<&str> {
-    text.lines().map(str::trim).filter(|l| l.starts_with('#')).collect()
+    text.lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with('#'))
+        .collect()
 }
 
 const EVERYWHERE: &str = "# header 1
@@ -116,7 +121,10 @@ fn comments_everywhere_survive_a_round_trip() {
     got.dedup();
     assert_eq!(got.len(), n, "a comment was written twice:\n{text}");
     let (back, _) = parse(&text);
-    assert_eq!(back, scene, "the written text reads back to a different scene:\n{text}");
+    assert_eq!(
+        back, scene,
+        "the written text reads back to a different scene:\n{text}"
+    );
     assert_eq!(write_scene(&back), text, "writing is canonical");
 }
 
@@ -124,16 +132,27 @@ fn comments_everywhere_survive_a_round_trip() {
 fn comments_stay_with_what_follows_them_at_its_indentation() {
     let (scene, _) = parse(EVERYWHERE);
     let text = write_scene(&scene);
-    assert!(text.starts_with("# header 1\n# header 2\nPerspectiveCamera {\n    # cam center\n    center 0 0 10\n"), "{text}");
+    assert!(
+        text.starts_with(
+            "# header 1\n# header 2\nPerspectiveCamera {\n    # cam center\n    center 0 0 10\n"
+        ),
+        "{text}"
+    );
     for (comment, next) in [
-        ("    # before MaterialIndex\n    # between MaterialIndex and Sphere\n", "    MaterialIndex 0\n    Sphere {"),
+        (
+            "    # before MaterialIndex\n    # between MaterialIndex and Sphere\n",
+            "    MaterialIndex 0\n    Sphere {",
+        ),
         ("        # radius\n", "        radius 1\n"),
         ("        # op 2\n", "        Scale 1 2 1\n"),
         ("        # light color\n", "        color 1 1 1\n"),
         ("            # inner group end\n", "        }\n"),
         ("    # group end\n", "}\n# end of file\n"),
     ] {
-        assert!(text.contains(&format!("{comment}{next}")), "expected {comment:?} before {next:?}:\n{text}");
+        assert!(
+            text.contains(&format!("{comment}{next}")),
+            "expected {comment:?} before {next:?}:\n{text}"
+        );
     }
 }
 
@@ -141,11 +160,20 @@ fn comments_stay_with_what_follows_them_at_its_indentation() {
 fn the_lecture_header_comment_is_written_back() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/lecture/simple_scene.txt");
     let original = std::fs::read_to_string(&path).expect("lecture scene");
-    let (scene, _) = load_scene(&path, &mut MeshCache::new()).into_result().expect("parses");
+    let (scene, _) = load_scene(&path, &mut MeshCache::new())
+        .into_result()
+        .expect("parses");
     let text = write_scene(&scene);
-    let header: String = original.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
+    let header: String = original
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect();
     assert!(!header.is_empty());
-    assert!(text.starts_with(&format!("{header}OrthographicCamera {{\n")), "{text}");
+    assert!(
+        text.starts_with(&format!("{header}OrthographicCamera {{\n")),
+        "{text}"
+    );
 }
 
 #[test]
@@ -161,7 +189,13 @@ Group {
 }
 ";
     let out = parse_scene(text.as_bytes(), "c.txt", None, &mut MeshCache::new());
-    let lost: Vec<String> = out.diagnostics.0.iter().filter(|d| d.severity == Severity::Warning && d.message.contains("comment")).map(|d| d.to_string()).collect();
+    let lost: Vec<String> = out
+        .diagnostics
+        .0
+        .iter()
+        .filter(|d| d.severity == Severity::Warning && d.message.contains("comment"))
+        .map(|d| d.to_string())
+        .collect();
     assert_eq!(lost.len(), 1, "{}", out.diagnostics);
     assert!(lost[0].starts_with("c.txt:6:16: "), "{}", lost[0]);
     assert_eq!(out.lost_comments.len(), 1);
@@ -173,7 +207,14 @@ Group {
 /// scene read back from the writer's text equals the scene read, comments included.
 #[test]
 fn a_comment_anywhere_round_trips_or_is_reported() {
-    let base: Vec<&str> = EVERYWHERE.lines().filter(|l| !l.trim_start().starts_with('#')).collect::<Vec<_>>().join("\n").leak().split_inclusive(char::is_whitespace).collect();
+    let base: Vec<&str> = EVERYWHERE
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n")
+        .leak()
+        .split_inclusive(char::is_whitespace)
+        .collect();
     for i in 0..=base.len() {
         let mut text: String = base[..i].concat();
         text.push_str("\n# inserted {here}\n");
@@ -181,7 +222,11 @@ fn a_comment_anywhere_round_trips_or_is_reported() {
         let out = parse_scene(text.as_bytes(), "c.txt", None, &mut MeshCache::new());
         let Some(scene) = out.scene else { continue };
         let written = write_scene(&scene);
-        assert_eq!(written.contains("# inserted {here}"), out.lost_comments.is_empty(), "kept or reported, at {i}:\n{text}");
+        assert_eq!(
+            written.contains("# inserted {here}"),
+            out.lost_comments.is_empty(),
+            "kept or reported, at {i}:\n{text}"
+        );
         let (back, _) = parse(&written);
         assert_eq!(back, scene, "at {i}:\n{text}\n---\n{written}");
     }
