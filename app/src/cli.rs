@@ -376,8 +376,16 @@ fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tra
     std::mem::replace(&mut *target.lock(), tracelab_core::Frame::new(0, 0))
 }
 
+/// Warnings (comments that cannot be kept, meshes not next to the scene) go to stderr
+/// before anything is written.
 fn run_fmt(scene: &Path, output: Option<&Path>) -> Result<(), CliError> {
-    let s = load(Some(scene))?;
+    let mut s = load(Some(scene))?;
+    if let Some(out) = output {
+        let dir = |p: &Path| p.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        for w in tracelab_core::rebase_mesh_paths(&mut s, &dir(scene), &dir(out)) {
+            eprintln!("{}: warning: {w}", out.display());
+        }
+    }
     let text = tracelab_core::write_scene(&s);
     match output {
         None => {

@@ -139,6 +139,7 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 return Err("no such op".into());
             }
             ops.remove(index);
+            g.node_mut(node).comments.remove_op(index);
         }
         Edit::MoveOp { node, from, to } => {
             let ops = transform_ops(g, node)?;
@@ -147,6 +148,7 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
             }
             let op = ops.remove(from);
             ops.insert(to, op);
+            g.node_mut(node).comments.move_op(from, to);
         }
         Edit::SetNodeKind { node, kind } => {
             let n = g.get_mut(node).ok_or("no such node")?;
@@ -216,8 +218,12 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 let other = *g.node(csg).children.iter().find(|&&c| c != node).ok_or("a CSG node needs two operands")?;
                 let slot_parent = parent_of(csg).ok_or("not in the scene")?;
                 let material = g.node(csg).material;
+                // The comments above the CSG node described the slot the survivor now fills.
+                let mut before = g.node(csg).comments.before.clone();
                 let o = g.node_mut(other);
                 o.material = o.material.or(material);
+                before.append(&mut o.comments.before);
+                o.comments.before = before;
                 for c in &mut g.node_mut(slot_parent).children {
                     if *c == csg {
                         *c = other;
@@ -287,6 +293,8 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
             let mut wrapper = Node::new(kind);
             // The MaterialIndex stays in front of whatever now sits in the parent.
             wrapper.material = g.node_mut(node).material.take();
+            // So do the comments above it.
+            wrapper.comments.before = std::mem::take(&mut g.node_mut(node).comments.before);
             wrapper.children.push(node);
             let w = g.add(wrapper);
             for c in &mut g.node_mut(parent).children {
@@ -388,4 +396,86 @@ fn copy_subtree(g: &mut tracelab_core::Graph, src: NodeId) -> NodeId {
         g.node_mut(map[&id]).children = kids;
     }
     map[&src]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }
+Materials { numMaterials 1 Material { diffuseColor 1 0 0 } }
+Group {
+    numObjects 2
+    # the keeper
+    Sphere { center 0 0 0 radius 1 }
+    # the doomed one
+    Transform {
+        # first op
+        Translate 1 0 0
+        # second op
+        Scale 1 2 1
+        Sphere {
+            # inside the doomed one
+            center 0 0 0 radius 1
+        }
+    }
+}
+";
+
+    fn parsed() -> Scene {
+        let out = tracelab_core::parse_scene(SCENE.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new());
+        out.scene.expect("parses")
+    }
+
+    fn node_of(scene: &Scene, kind: &str, nth: usize) -> NodeId {
+        scene.graph.iter().filter(|(_, n)| n.kind.name() == kind).nth(nth).map(|(id, _)| id).expect("node")
+    }
+
+    fn written(scene: &Scene) -> String {
+        tracelab_core::write_scene(scene)
+    }
+
+    #[test]
+    fn a_deleted_node_takes_its_comments_with_it() {
+        let mut s = parsed();
+        let inner = node_of(&s, "Sphere", 1);
+        apply_to(&mut s, Edit::DeleteNode { node: inner }).expect("deletes");
+        let text = written(&s);
+        assert!(text.contains("# the keeper"), "{text}");
+        for gone in ["the doomed one", "first op", "inside the doomed one"] {
+            assert!(!text.contains(gone), "{gone} survived:\n{text}");
+        }
+    }
+
+    #[test]
+    fn a_wrapped_node_s_comments_stay_in_front_of_the_wrapper() {
+        let mut s = parsed();
+        let keeper = node_of(&s, "Sphere", 0);
+        apply_to(&mut s, Edit::WrapInGroup { node: keeper }).expect("wraps");
+        let text = written(&s);
+        assert!(text.contains("    # the keeper\n    Group {\n"), "{text}");
+        let mut d = parsed();
+        apply_to(&mut d, Edit::DuplicateNode { node: keeper }).expect("duplicates");
+        assert_eq!(written(&d).matches("# the keeper").count(), 2, "a copy carries its comments");
+    }
+
+    #[test]
+    fn op_comments_follow_their_ops() {
+        let mut s = parsed();
+        let t = node_of(&s, "Transform", 0);
+        apply_to(&mut s, Edit::MoveOp { node: t, from: 0, to: 1 }).expect("moves");
+        assert!(written(&s).contains("        # second op\n        Scale 1 2 1\n        # first op\n        Translate 1 0 0\n"), "{}", written(&s));
+        apply_to(&mut s, Edit::RemoveOp { node: t, index: 0 }).expect("removes");
+        let text = written(&s);
+        assert!(!text.contains("second op") && text.contains("        # first op\n        Translate 1 0 0\n"), "{text}");
+    }
+
+    #[test]
+    fn deleting_a_csg_operand_keeps_the_comments_above_the_csg_node() {
+        let text = SCENE.replace("numObjects 2", "numObjects 3\n    # the union\n    Union { Sphere { center 0 0 0 radius 1 } Box { min 0 0 0 max 1 1 1 } }");
+        let mut s = tracelab_core::parse_scene(text.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new()).scene.expect("parses");
+        let b = node_of(&s, "Box", 0);
+        apply_to(&mut s, Edit::DeleteNode { node: b }).expect("deletes");
+        assert!(written(&s).contains("    # the union\n    Sphere {"), "{}", written(&s));
+    }
 }

@@ -37,6 +37,9 @@ pub struct Document {
     /// Modification time of `path` when last read or written, to notice outside changes.
     pub disk_stamp: Option<SystemTime>,
     pub mesh_cache: MeshCache,
+    /// Comments of the opened file that saving drops (file:line:col: why), for
+    /// [`Document::save_warnings`].
+    pub lost_comments: Vec<String>,
     undo: Vec<Snapshot>,
     redo: Vec<Snapshot>,
     state_id: u64,
@@ -60,6 +63,7 @@ impl Document {
             messages: Vec::new(),
             disk_stamp,
             mesh_cache: MeshCache::new(),
+            lost_comments: Vec::new(),
             undo: Vec::new(),
             redo: Vec::new(),
             state_id: 0,
@@ -206,6 +210,7 @@ impl Document {
     pub fn open(&mut self, path: &Path) -> Result<(), String> {
         let out = tracelab_core::load_scene(path, &mut self.mesh_cache);
         let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
+        let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
         match out.scene {
             Some(scene) => {
                 let cache = std::mem::take(&mut self.mesh_cache);
@@ -213,6 +218,7 @@ impl Document {
                 *self = Document::new(scene, Some(path.to_path_buf()));
                 self.mesh_cache = cache;
                 self.messages = messages;
+                self.lost_comments = lost_comments;
                 // Generations stay monotonic across documents: the worker compares them.
                 self.generation = generation;
                 Ok(())
@@ -225,11 +231,36 @@ impl Document {
         }
     }
 
-    /// Writes the scene atomically (temporary file + rename) and marks it saved.
+    /// What saving to `path` would lose or leave unfixed, one line each, to show before or
+    /// on saving: comments of the opened file that cannot be kept, and relative mesh paths
+    /// that cannot be rewritten for `path`'s folder.
+    pub fn save_warnings(&self, path: &Path) -> Vec<String> {
+        let mut scene = self.scene.clone();
+        let mut out = self.lost_comments.clone();
+        out.extend(tracelab_core::rebase_mesh_paths(&mut scene, &self.folder(), &folder_of(path)));
+        out
+    }
+
+    /// Where relative `obj_file` paths of the document resolve from: its file's folder, or
+    /// the current folder for a scene never saved.
+    fn folder(&self) -> PathBuf {
+        self.path.as_deref().map_or_else(|| PathBuf::from("."), folder_of)
+    }
+
+    /// Writes the scene atomically (temporary file + rename) and marks it saved. Relative
+    /// mesh paths are rewritten for the new folder first, in the whole history, so they keep
+    /// naming the same files from there (and after an undo).
     pub fn save_as(&mut self, path: &Path) -> Result<(), String> {
-        let text = tracelab_core::write_scene(&self.scene);
+        let (from, to) = (self.folder(), folder_of(path));
+        let mut scene = self.scene.clone();
+        tracelab_core::rebase_mesh_paths(&mut scene, &from, &to);
+        let text = tracelab_core::write_scene(&scene);
         crate::cli::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        self.scene = scene;
+        for s in self.undo.iter_mut().chain(self.redo.iter_mut()) {
+            tracelab_core::rebase_mesh_paths(&mut s.scene, &from, &to);
+        }
         self.path = Some(path.to_path_buf());
         self.saved_state_id = self.state_id;
         self.disk_stamp = modified(path);
@@ -252,6 +283,71 @@ impl Document {
     }
 }
 
+fn folder_of(file: &Path) -> PathBuf {
+    file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+}
+
 fn modified(p: &Path) -> Option<SystemTime> {
     std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edit::Edit;
+    use tracelab_core::NodeKind;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("tracelab-state-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(d.join("scenes")).expect("dirs");
+        std::fs::create_dir_all(d.join("out/sub")).expect("dirs");
+        d
+    }
+
+    fn obj_file(scene: &Scene) -> Option<String> {
+        scene.graph.iter().find_map(|(_, n)| match &n.kind {
+            NodeKind::TriangleMesh { obj_file, .. } => Some(obj_file.clone()),
+            _ => None,
+        })
+    }
+
+    const SCENE: &str = "# header\nPerspectiveCamera { center 3 3 5 direction -3 -3 -5 up 0 1 0 angle 40 }\nMaterials { numMaterials 1 Material { diffuseColor 1 1 1 } }\nGroup { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file mesh.obj } }\n";
+
+    #[test]
+    fn save_as_into_a_sub_folder_rewrites_mesh_paths_and_keeps_comments() {
+        let d = temp_dir("save-as");
+        let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/cube.obj");
+        std::fs::copy(cube, d.join("scenes/mesh.obj")).expect("obj");
+        std::fs::write(d.join("scenes/s.txt"), SCENE).expect("scene");
+        let mut doc = Document::new(Scene::default(), None);
+        doc.open(&d.join("scenes/s.txt")).expect("opens");
+        let root = doc.scene.graph.root();
+        doc.apply(Edit::SetNodeMaterial { node: doc.scene.graph.node(root).children[0], material: None }).expect("an edit to undo");
+        let out = d.join("out/sub/s.txt");
+        assert!(doc.save_warnings(&out).is_empty());
+        doc.save_as(&out).expect("saves");
+        let text = std::fs::read_to_string(&out).expect("saved");
+        assert!(text.starts_with("# header\n"), "{text}");
+        assert!(text.contains("obj_file ../../scenes/mesh.obj\n"), "{text}");
+        // The saved file finds its mesh from its own folder (the tests' working folder has none).
+        let (saved, _) = tracelab_core::load_scene(&out, &mut MeshCache::new()).into_result().expect("loads");
+        assert!(saved.graph.iter().any(|(_, n)| matches!(&n.kind, NodeKind::TriangleMesh { mesh, .. } if mesh.mesh().is_some())));
+        // The document and its history now speak relative to the new folder.
+        assert_eq!(obj_file(&doc.scene).as_deref(), Some("../../scenes/mesh.obj"));
+        assert!(doc.undo());
+        assert_eq!(obj_file(&doc.scene).as_deref(), Some("../../scenes/mesh.obj"));
+    }
+
+    #[test]
+    fn save_warnings_name_comments_the_save_drops() {
+        let d = temp_dir("lost");
+        let text = SCENE.replace("angle 40", "angle # forty\n 40").replace("mesh.obj", "/nonexistent/mesh.obj");
+        std::fs::write(d.join("scenes/s.txt"), text).expect("scene");
+        let mut doc = Document::new(Scene::default(), None);
+        doc.open(&d.join("scenes/s.txt")).expect("opens with a missing mesh");
+        let w = doc.save_warnings(&d.join("scenes/s.txt"));
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("s.txt:2:") && w[0].contains("comment"), "{w:?}");
+    }
 }

@@ -119,3 +119,69 @@ fn fmt_writes_canonical_text_that_reads_back() {
     let leftovers: Vec<_> = std::fs::read_dir(&d).expect("dir").filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("tmp")).collect();
     assert!(leftovers.is_empty());
 }
+
+#[test]
+fn fmt_keeps_comments() {
+    let d = temp_dir("fmt-comments");
+    let src = "# a header\nOrthographicCamera{center 0 0 10 direction 0 0 -1 up 0 1 0 size 5}\nMaterials{numMaterials 1 Material{diffuseColor 1 0 0}}\nGroup{numObjects 1\n# the ball\nMaterialIndex 0 Sphere{center 0 0 0\n# its radius\nradius 1}}\n# the end\n";
+    std::fs::write(d.join("s.txt"), src).expect("write");
+    let o = tracelab(&["fmt", "s.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for c in ["# a header\nOrthographicCamera {", "    # the ball\n    MaterialIndex 0\n", "        # its radius\n        radius 1\n", "}\n# the end\n"] {
+        assert!(text.contains(c), "{c:?} missing:\n{text}");
+    }
+}
+
+#[test]
+fn fmt_warns_about_a_comment_it_cannot_keep_before_writing() {
+    let d = temp_dir("fmt-lost");
+    std::fs::write(d.join("s.txt"), "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size # five\n 5 }\nGroup { }\n").expect("write");
+    let o = tracelab(&["fmt", "s.txt", "-o", "out.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("s.txt:1:67: warning: this comment stands inside a value"), "{}", stderr(&o));
+}
+
+/// A scene in `scenes/` using `mesh.obj` beside it, formatted into `out/sub/`: the written
+/// file must find the mesh from its own folder, whatever the working directory.
+#[test]
+fn fmt_into_another_folder_rewrites_relative_mesh_paths() {
+    let d = temp_dir("fmt-rebase");
+    for sub in ["scenes", "out/sub", "elsewhere"] {
+        std::fs::create_dir_all(d.join(sub)).expect("dirs");
+    }
+    std::fs::copy(repo().join("assets/cube.obj"), d.join("scenes/mesh.obj")).expect("obj");
+    let src = "PerspectiveCamera { center 3 3 5 direction -3 -3 -5 up 0 1 0 angle 40 }\nMaterials { numMaterials 1 Material { diffuseColor 1 1 1 } }\nGroup { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file mesh.obj } }\n";
+    std::fs::write(d.join("scenes/s.txt"), src).expect("scene");
+    let o = tracelab(&["fmt", "scenes/s.txt", "-o", "out/sub/o.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(d.join("out/sub/o.txt")).expect("written");
+    assert!(text.contains("obj_file ../../scenes/mesh.obj\n"), "{text}");
+    let written = d.join("out/sub/o.txt");
+    let written = written.to_str().expect("utf-8 path");
+    // From a folder without the mesh, and from the mesh's own folder (where the loader's
+    // current-folder fallback would have hidden a wrong path): found next to the file.
+    for cwd in ["elsewhere", "scenes"] {
+        let o = tracelab(&["render", written, "--size", "8", "8", "--output", "o.png"], &d.join(cwd));
+        assert!(o.status.success(), "from {cwd}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("current folder"), "from {cwd}: {}", stderr(&o));
+    }
+    // Formatting in place keeps the name as written.
+    let o = tracelab(&["fmt", "scenes/s.txt", "-o", "scenes/again.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read_to_string(d.join("scenes/again.txt")).expect("again").contains("obj_file mesh.obj\n"));
+}
+
+#[test]
+fn a_mesh_found_only_in_the_current_folder_is_reported() {
+    let d = temp_dir("cwd-fallback");
+    std::fs::create_dir_all(d.join("scenes")).expect("dirs");
+    std::fs::copy(repo().join("assets/cube.obj"), d.join("mesh.obj")).expect("obj");
+    let src = "PerspectiveCamera { center 3 3 5 direction -3 -3 -5 up 0 1 0 angle 40 }\nMaterials { numMaterials 1 Material { diffuseColor 1 1 1 } }\nGroup { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file mesh.obj } }\n";
+    std::fs::write(d.join("scenes/s.txt"), src).expect("scene");
+    // The course's way (mesh in the working folder, scene elsewhere) still renders...
+    let o = tracelab(&["-input", "scenes/s.txt", "-size", "8", "8", "-output", "o.png"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // ...but says where the mesh came from.
+    assert!(stderr(&o).contains("not in the scene's folder"), "{}", stderr(&o));
+}

@@ -129,17 +129,11 @@ fn random_edit(r: &mut Rng, d: &Document) -> Edit {
             up: r.v(),
             size: r.f(),
         }),
-        16 => Edit::AddLight(Light {
-            direction: r.v(),
-            color: r.v(),
-        }),
+        16 => Edit::AddLight(Light::new(r.v(), r.v())),
         17 => Edit::RemoveLight { index: r.below(4) },
         18 => Edit::SetLight {
             index: r.below(4),
-            light: Light {
-                direction: r.v(),
-                color: r.v(),
-            },
+            light: Light::new(r.v(), r.v()),
         },
         _ => Edit::SetBackground(Background {
             color: Some(r.v()),

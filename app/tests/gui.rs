@@ -150,6 +150,11 @@ fn edit_save_undo(scene: PathBuf) {
 
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     h.step();
+    // Save As moved the document, so its relative mesh paths (undo history included) now
+    // start from the new folder.
+    let mut original = original;
+    let dir = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
+    tracelab_core::rebase_mesh_paths(&mut original, &dir(&scene), &dir(&out));
     assert_eq!(
         h.state().doc.scene,
         original,

@@ -24,7 +24,7 @@ fn sphere_under(m: Mat4) -> Scene {
     let mut scene = Scene::default();
     scene.materials.push(Material::diffuse(Vec3::ONE));
     let mut g = Graph::new();
-    let t = g.add(Node { kind: NodeKind::Transform(vec![TransformOp::Matrix(m)]), material: Some(0), children: vec![] });
+    let t = g.add(Node { material: Some(0), ..Node::new(NodeKind::Transform(vec![TransformOp::Matrix(m)])) });
     let s = g.add(Node::new(NodeKind::Sphere { center: Vec3::ZERO, radius: 1.0 }));
     g.push_child(g.root(), t);
     g.push_child(t, s);

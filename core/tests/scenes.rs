@@ -85,9 +85,10 @@ const COURSE_WORDS: &[&str] = &[
     "Transform", "Scale", "UniformScale", "Translate", "XRotate", "YRotate", "ZRotate", "Rotate", "Matrix", "{", "}",
 ];
 
+/// Comments are skipped: they are written back only where the file read had them.
 fn assert_course_grammar(text: &str, what: &str) {
     let mut prev = "";
-    for w in text.split_whitespace() {
+    for w in text.lines().flat_map(|l| l.split('#').next().unwrap_or("").split_whitespace()) {
         let ok = COURSE_WORDS.contains(&w) || w.parse::<f32>().is_ok() || prev == "obj_file";
         assert!(ok, "{what}: \"{w}\" is not in the course grammar");
         prev = w;

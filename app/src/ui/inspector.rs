@@ -29,10 +29,7 @@ pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
                     light(ui, doc, i, &mut edits);
                 }
                 if ui.button("Add light").clicked() {
-                    edits.push(Edit::AddLight(Light {
-                        direction: Vec3::new(-0.5, -1.0, -0.5),
-                        color: Vec3::splat(0.5),
-                    }));
+                    edits.push(Edit::AddLight(Light::new(Vec3::new(-0.5, -1.0, -0.5), Vec3::splat(0.5))));
                 }
             }
             Some(Selection::Light(i)) => light(ui, doc, i, &mut edits),

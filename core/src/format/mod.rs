@@ -5,8 +5,10 @@ mod diagnostic;
 mod lexer;
 pub mod obj;
 mod parser;
+mod rebase;
 mod writer;
 
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
 pub use parser::{ParseOutcome, load_scene, parse_scene};
+pub use rebase::rebase_mesh_paths;
 pub use writer::{uses_only_course_grammar, write_scene};

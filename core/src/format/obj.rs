@@ -14,6 +14,12 @@ use glam::Vec3;
 use crate::scene::Mesh;
 
 /// Resolves `obj_file` against the scene's folder first, then the current folder.
+///
+/// The current-folder fallback stays for the course's command lines, which open OBJ files
+/// relative to the working directory (`raytracer -input ../scenes/x.txt` run from the folder
+/// holding the mesh). It cannot mask a saved path: the scene's own folder is tried first,
+/// Save As and `fmt -o` rewrite relative paths against that folder alone
+/// ([`crate::format::rebase_mesh_paths`]), and the parser warns whenever the fallback is used.
 pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, String> {
     let mut tried = Vec::new();
     if let Some(dir) = base_dir {

@@ -9,11 +9,11 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
-use super::lexer::{TokKind, Token, tokenize};
+use super::lexer::{Comment, TokKind, Token, tokenize_with_comments};
 use super::obj::{MeshCache, resolve_obj_path};
 use crate::scene::{
-    Background, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node, NodeId,
-    NodeKind, Scene, TransformOp, check_closed, compose,
+    Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node,
+    NodeId, NodeKind, Scene, SceneComments, TransformOp, check_closed, compose,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -23,6 +23,10 @@ use crate::scene::{
 pub struct ParseOutcome {
     pub scene: Option<Scene>,
     pub diagnostics: Diagnostics,
+    /// Comments that stand where the scene cannot keep them (between a keyword and its
+    /// value): writing the scene drops them. Each is also among `diagnostics` as a warning;
+    /// kept apart so a save can repeat them (see [`ParseOutcome::lost_comments`]).
+    pub lost_comments: Vec<Diagnostic>,
 }
 
 impl ParseOutcome {
@@ -32,6 +36,11 @@ impl ParseOutcome {
             Some(s) if !self.diagnostics.has_errors() => Ok((s, self.diagnostics)),
             _ => Err(self.diagnostics),
         }
+    }
+
+    /// Comments that writing the scene would drop, as warnings with file:line:col.
+    pub fn lost_comments(&self) -> &[Diagnostic] {
+        &self.lost_comments
     }
 }
 
@@ -49,6 +58,7 @@ pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
                 col: 0,
                 message: format!("cannot read scene file: {e}"),
             }]),
+            lost_comments: Vec::new(),
         },
     }
 }
@@ -73,12 +83,18 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
                 valid_up_to,
                 format!("this is not a text scene file: found {what}"),
             );
-            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]) };
+            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]), lost_comments: Vec::new() };
         }
     };
+    let (toks, comments) = tokenize_with_comments(text);
     let mut p = Parser {
         src: SourceFile::new(name, text),
-        toks: tokenize(text),
+        toks,
+        comments,
+        next_comment: 0,
+        pending_comments: Vec::new(),
+        lost_comments: Vec::new(),
+        scene_comments: SceneComments::default(),
         pos: 0,
         diags: Vec::new(),
         fatal: false,
@@ -103,6 +119,13 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
 struct Parser<'a> {
     src: SourceFile<'a>,
     toks: Vec<Token>,
+    /// Comments in file order; those before `next_comment` have been attached or lost.
+    comments: Vec<Comment>,
+    next_comment: usize,
+    /// Comments before a MaterialIndex, waiting for the object it applies to.
+    pending_comments: Vec<String>,
+    lost_comments: Vec<Diagnostic>,
+    scene_comments: SceneComments,
     pos: usize,
     diags: Vec<Diagnostic>,
     /// Set by any error that leaves the scene incomplete.
@@ -141,6 +164,8 @@ struct Field {
     /// still taken if it is a real field (`center 0 0 radius 1` must not also say radius
     /// is missing).
     swallowed: bool,
+    /// Comments before the field's name.
+    comments: Vec<String>,
 }
 
 enum Frame {
@@ -182,6 +207,15 @@ const OBJECT_KEYWORDS: &[&str] = &[
     "Subtraction",
 ];
 
+/// An item's comments: those before its keyword, before each field, and before its `}`.
+fn block_comments(before: Vec<String>, fields: &mut [Field], end: Vec<String>) -> Comments {
+    let mut c = Comments { before, end, ..Comments::default() };
+    for f in fields.iter_mut().filter(|f| !f.comments.is_empty()) {
+        c.inner.entry(Anchor::Field(f.name.clone())).or_default().append(&mut f.comments);
+    }
+    c
+}
+
 fn is_numberlike(s: &str) -> bool {
     let first = s.as_bytes().first().copied().unwrap_or(b'a');
     first.is_ascii_digit()
@@ -202,6 +236,43 @@ impl<'a> Parser<'a> {
             self.pos += 1;
         }
         t
+    }
+
+    /// Takes the comments that stand before token `tok`, which starts something the scene
+    /// keeps comments for (a keyword, a field, a closing brace). Earlier comments nobody
+    /// took stood inside something (between a keyword and its value) and are lost.
+    fn comments_before(&mut self, tok: usize) -> Vec<String> {
+        let mut out = std::mem::take(&mut self.pending_comments);
+        while let Some(c) = self.comments.get(self.next_comment).copied() {
+            if c.next_token > tok {
+                break;
+            }
+            self.next_comment += 1;
+            let text: &'a str = self.src.text;
+            if c.next_token == tok {
+                out.push(text[c.start..c.end].to_string());
+            } else {
+                let d = self.src.diagnostic(
+                    Severity::Warning,
+                    c.start.saturating_sub(1),
+                    "this comment stands inside a value (between a keyword and what it takes), where it cannot be kept: saving the scene drops it",
+                );
+                self.lost_comments.push(d.clone());
+                self.diags.push(d);
+            }
+        }
+        out
+    }
+
+    /// Comments before the token just read (`self.pos - 1`).
+    fn comments_here(&mut self) -> Vec<String> {
+        self.comments_before(self.pos.saturating_sub(1))
+    }
+
+    /// Comments before the token just read belong to what comes next (a MaterialIndex's to
+    /// the object it applies to).
+    fn defer_comments(&mut self) {
+        self.pending_comments = self.comments_here();
     }
 
     fn text(&self, t: Token) -> &'a str {
@@ -326,16 +397,20 @@ impl<'a> Parser<'a> {
 
     /// Reads `name numbers…` lines up to the closing `}` of a block whose `{` was read.
     /// Returns None (having reported why) if the block is malformed.
-    fn read_fields(&mut self, block: &str, open: usize) -> Option<Vec<Field>> {
+    fn read_fields(&mut self, block: &str, open: usize) -> Option<(Vec<Field>, Vec<String>)> {
         let mut fields: Vec<Field> = Vec::new();
         let mut ok = true;
+        let end_comments;
         loop {
             let Some(t) = self.next() else {
                 self.error(open, format!("unterminated {block} block: expected \"}}\" before the end of the file"));
                 return None;
             };
             match t.kind {
-                TokKind::Close => break,
+                TokKind::Close => {
+                    end_comments = self.comments_here();
+                    break;
+                }
                 TokKind::Open => {
                     self.error(t.start, format!("unexpected \"{{\" inside {block}"));
                     self.skip_block();
@@ -356,7 +431,9 @@ impl<'a> Parser<'a> {
                         ok = false;
                         continue;
                     }
+                    let comments = self.comments_here();
                     let mut field = Field {
+                        comments,
                         name: name.to_string(),
                         name_off: t.start,
                         values: Vec::new(),
@@ -394,7 +471,7 @@ impl<'a> Parser<'a> {
                 }
             }
         }
-        ok.then_some(fields)
+        ok.then_some((fields, end_comments))
     }
 
     /// Takes field `name` with exactly `n` numbers; reports what is wrong otherwise.
@@ -493,8 +570,10 @@ impl<'a> Parser<'a> {
     }
 
     fn parse_camera(&mut self, kw: &str, off: usize) {
+        let before = self.comments_here();
         let Some(open) = self.expect_open(kw) else { return };
-        let Some(mut f) = self.read_fields(kw, open) else { return };
+        let Some((mut f, end)) = self.read_fields(kw, open) else { return };
+        self.scene_comments.camera = block_comments(before, &mut f, end);
         if self.camera.is_some() {
             self.error(off, "a scene has one camera; this is a second");
         }
@@ -532,8 +611,10 @@ impl<'a> Parser<'a> {
     }
 
     fn parse_background(&mut self, off: usize) {
+        let before = self.comments_here();
         let Some(open) = self.expect_open("Background") else { return };
-        let Some(mut f) = self.read_fields("Background", open) else { return };
+        let Some((mut f, end)) = self.read_fields("Background", open) else { return };
+        self.scene_comments.background = block_comments(before, &mut f, end);
         let mut bg = Background::default();
         if f.iter().any(|x| x.name == "color") {
             bg.color = self.take_vec3(&mut f, "Background", off, "color");
@@ -549,6 +630,7 @@ impl<'a> Parser<'a> {
     }
 
     fn parse_lights(&mut self, off: usize) {
+        let mut comments = Comments { before: self.comments_here(), ..Comments::default() };
         let Some(open) = self.expect_open("Lights") else { return };
         if self.lights.is_some() {
             self.error(off, "a scene has one Lights block; this is a second");
@@ -561,11 +643,22 @@ impl<'a> Parser<'a> {
                 return;
             };
             match (t.kind, self.text(t)) {
-                (TokKind::Close, _) => break,
-                (TokKind::Word, "numLights") => declared = self.expect_count("numLights"),
+                (TokKind::Close, _) => {
+                    comments.end = self.comments_here();
+                    break;
+                }
+                (TokKind::Word, "numLights") => {
+                    let c = self.comments_here();
+                    if !c.is_empty() {
+                        comments.inner.entry(Anchor::Field("numLights".into())).or_default().extend(c);
+                    }
+                    declared = self.expect_count("numLights")
+                }
                 (TokKind::Word, "DirectionalLight") => {
+                    let before = self.comments_here();
                     let Some(o) = self.expect_open("DirectionalLight") else { continue };
-                    let Some(mut f) = self.read_fields("DirectionalLight", o) else { continue };
+                    let Some((mut f, end)) = self.read_fields("DirectionalLight", o) else { continue };
+                    let light_comments = block_comments(before, &mut f, end);
                     let d = self.take_vec3(&mut f, "DirectionalLight", t.start, "direction");
                     let c = self.take_vec3(&mut f, "DirectionalLight", t.start, "color");
                     self.reject_unused(&f, "DirectionalLight", "direction, color");
@@ -573,7 +666,7 @@ impl<'a> Parser<'a> {
                         if direction.length_squared() == 0.0 {
                             self.error(t.start, "DirectionalLight: direction must not be zero");
                         }
-                        lights.push(Light { direction, color });
+                        lights.push(Light { direction, color, comments: light_comments });
                     }
                 }
                 (_, w) => {
@@ -594,12 +687,14 @@ impl<'a> Parser<'a> {
             None => self.warn(off, "Lights has no numLights; counting the lights instead"),
             _ => {}
         }
+        self.scene_comments.lights = comments;
         self.lights = Some(lights);
     }
 
     fn parse_material_block(&mut self, kw: &str, off: usize) -> Option<Material> {
+        let before = self.comments_here();
         let open = self.expect_open(kw)?;
-        let mut f = self.read_fields(kw, open)?;
+        let (mut f, end) = self.read_fields(kw, open)?;
         let diffuse = self.take_vec3(&mut f, kw, off, "diffuseColor")?;
         let keyword = if kw == "PhongMaterial" { MaterialKeyword::PhongMaterial } else { MaterialKeyword::Material };
         // Other fields (specularColor, exponent, …) are kept, not shaded with.
@@ -608,10 +703,12 @@ impl<'a> Parser<'a> {
             .filter(|x| !x.used)
             .map(|x| (x.name.clone(), x.values.iter().map(|v| v.0).collect()))
             .collect();
-        Some(Material { diffuse, keyword, extra })
+        let comments = block_comments(before, &mut f, end);
+        Some(Material { diffuse, keyword, extra, comments })
     }
 
     fn parse_materials(&mut self, off: usize) {
+        let mut comments = Comments { before: self.comments_here(), ..Comments::default() };
         let Some(open) = self.expect_open("Materials") else { return };
         let mut declared = None;
         let mut count = 0;
@@ -621,8 +718,17 @@ impl<'a> Parser<'a> {
                 return;
             };
             match (t.kind, self.text(t)) {
-                (TokKind::Close, _) => break,
-                (TokKind::Word, "numMaterials") => declared = self.expect_count("numMaterials"),
+                (TokKind::Close, _) => {
+                    comments.end = self.comments_here();
+                    break;
+                }
+                (TokKind::Word, "numMaterials") => {
+                    let c = self.comments_here();
+                    if !c.is_empty() {
+                        comments.inner.entry(Anchor::Field("numMaterials".into())).or_default().extend(c);
+                    }
+                    declared = self.expect_count("numMaterials")
+                }
                 (TokKind::Word, kw @ ("Material" | "PhongMaterial")) => {
                     count += 1;
                     if let Some(m) = self.parse_material_block(kw, t.start) {
@@ -650,11 +756,13 @@ impl<'a> Parser<'a> {
             None => self.warn(off, "Materials has no numMaterials; counting the materials instead"),
             _ => {}
         }
+        self.scene_comments.materials = comments;
     }
 
     // ---------------------------------------------------------------- the object tree
 
     fn parse_object_tree(&mut self, off: usize) {
+        let before = self.comments_here();
         let Some(open) = self.expect_open("Group") else { return };
         if self.graph.is_some() {
             self.error(off, "a scene has one top-level Group; this is a second");
@@ -663,6 +771,7 @@ impl<'a> Parser<'a> {
         }
         let mut graph = Graph::new();
         let root = graph.root();
+        graph.node_mut(root).comments.before = before;
         let mut stack =
             vec![Frame::Group { node: root, open, declared: None, count: 0, material: None }];
         while !stack.is_empty() {
@@ -679,6 +788,10 @@ impl<'a> Parser<'a> {
             match t.kind {
                 TokKind::Close => {
                     if let Some(frame) = stack.pop() {
+                        let node = match &frame {
+                            Frame::Group { node, .. } | Frame::Transform { node, .. } | Frame::Csg { node, .. } => *node,
+                        };
+                        graph.node_mut(node).comments.end = self.comments_here();
                         self.close_frame(frame, &mut graph);
                     }
                 }
@@ -694,6 +807,10 @@ impl<'a> Parser<'a> {
                                 let parent = *node;
                                 match w {
                                     "numObjects" => {
+                                        let c = self.comments_here();
+                                        if !c.is_empty() {
+                                            graph.node_mut(parent).comments.inner.entry(Anchor::Field("numObjects".into())).or_default().extend(c);
+                                        }
                                         if declared.is_some() {
                                             self.error(t.start, "numObjects is given twice in this Group");
                                         }
@@ -703,6 +820,7 @@ impl<'a> Parser<'a> {
                                         }
                                     }
                                     "MaterialIndex" => {
+                                        self.defer_comments();
                                         if let Some((i, at)) = self.expect_count("MaterialIndex") {
                                             let i = u32::try_from(i).unwrap_or(u32::MAX);
                                             self.material_refs.push((i, at));
@@ -754,9 +872,16 @@ impl<'a> Parser<'a> {
                                     if let Some(f) = self.start_object(w, t.start, parent, None, &mut graph) {
                                         stack.push(f);
                                     }
-                                } else if let Some(op) = self.parse_op(w, t.start) {
+                                } else {
+                                    let c = self.comments_here();
+                                    let Some(op) = self.parse_op(w, t.start) else { continue };
                                     match stack.last_mut() {
-                                        Some(Frame::Transform { ops, has_child: false, .. }) => ops.push((op, t.start)),
+                                        Some(Frame::Transform { ops, has_child: false, .. }) => {
+                                            if !c.is_empty() {
+                                                graph.node_mut(parent).comments.inner.entry(Anchor::Op(ops.len())).or_default().extend(c);
+                                            }
+                                            ops.push((op, t.start))
+                                        }
                                         _ => self.error(t.start, "transform operations must come before the Transform's object"),
                                     }
                                 }
@@ -764,6 +889,7 @@ impl<'a> Parser<'a> {
                             Frame::Csg { node, op, count, material, .. } => {
                                 let (parent, op) = (*node, *op);
                                 if w == "MaterialIndex" {
+                                    self.defer_comments();
                                     if let Some((i, at)) = self.expect_count("MaterialIndex") {
                                         let i = u32::try_from(i).unwrap_or(u32::MAX);
                                         self.material_refs.push((i, at));
@@ -891,37 +1017,41 @@ impl<'a> Parser<'a> {
         material: Option<u32>,
         graph: &mut Graph,
     ) -> Option<Frame> {
+        let before = self.comments_here();
         let open = self.expect_open(w)?;
-        let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind| {
-            let id = graph.add(Node { kind, material, children: Vec::new() });
+        let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind, comments: Comments| {
+            let id = graph.add(Node { kind, material, children: Vec::new(), comments });
             graph.push_child(parent, id);
             this.record_offset(id, off);
             id
         };
         if let Some(op) = CsgOp::from_name(w) {
-            let node = attach(self, graph, NodeKind::Csg(op));
+            let node = attach(self, graph, NodeKind::Csg(op), Comments { before, ..Comments::default() });
             return Some(Frame::Csg { node, op, keyword: off, open, count: 0, material: None });
         }
         match w {
             "Group" => {
-                let node = attach(self, graph, NodeKind::Group);
+                let node = attach(self, graph, NodeKind::Group, Comments { before, ..Comments::default() });
                 Some(Frame::Group { node, open, declared: None, count: 0, material: None })
             }
             "Transform" => {
-                let node = attach(self, graph, NodeKind::Transform(Vec::new()));
+                let node = attach(self, graph, NodeKind::Transform(Vec::new()), Comments { before, ..Comments::default() });
                 Some(Frame::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
             }
             _ => {
-                let kind = self.parse_primitive(w, off, open)?;
-                let id = attach(self, graph, kind);
+                let (kind, mut comments) = self.parse_primitive(w, off, open)?;
+                comments.before = before;
+                let id = attach(self, graph, kind, comments);
                 self.leaf_offsets.push((id, off));
                 None
             }
         }
     }
 
-    fn parse_primitive(&mut self, w: &str, off: usize, open: usize) -> Option<NodeKind> {
-        let mut f = self.read_fields(w, open)?;
+    /// The primitive and the comments inside its block.
+    fn parse_primitive(&mut self, w: &str, off: usize, open: usize) -> Option<(NodeKind, Comments)> {
+        let (mut f, end) = self.read_fields(w, open)?;
+        let comments = block_comments(Vec::new(), &mut f, end);
         let kind = match w {
             "Sphere" => {
                 let center = self.take_vec3(&mut f, w, off, "center");
@@ -971,13 +1101,17 @@ impl<'a> Parser<'a> {
             }
             _ => return None,
         };
-        Some(kind)
+        Some((kind, comments))
     }
 
     fn load_mesh(&mut self, name: &str, off: usize) -> MeshSlot {
         let result = resolve_obj_path(name, self.base_dir).and_then(|path| self.cache.load(&path));
         match result {
             Ok(mesh) => {
+                if let Some(dir) = self.base_dir.filter(|d| !d.join(name).is_file()) {
+                    let dir = if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() };
+                    self.warn(off, format!("OBJ file \"{name}\" is not in the scene's folder ({dir}); using the one in the current folder"));
+                }
                 if mesh.triangle_count() == 0 {
                     self.warn(off, format!("OBJ file \"{name}\" has no triangles"));
                 }
@@ -1079,6 +1213,7 @@ impl<'a> Parser<'a> {
 
     fn finish(mut self) -> ParseOutcome {
         let end = self.src.text.len();
+        self.scene_comments.end = self.comments_before(self.toks.len());
         let n = self.materials.len();
         for (i, at) in std::mem::take(&mut self.material_refs) {
             if i as usize >= n {
@@ -1117,8 +1252,9 @@ impl<'a> Parser<'a> {
                 background: self.background.take().unwrap_or_default(),
                 materials: std::mem::take(&mut self.materials),
                 graph: self.graph.take().unwrap_or_default(),
+                comments: std::mem::take(&mut self.scene_comments),
             })
         };
-        ParseOutcome { scene, diagnostics: Diagnostics(self.diags) }
+        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments }
     }
 }

@@ -1,11 +1,14 @@
 //! Writes a scene back in the 6.837 format, canonically indented. Numbers use Rust's
-//! shortest round-trip formatting, so every f32 reads back to the same value.
+//! shortest round-trip formatting, so every f32 reads back to the same value. Comments go
+//! back on lines of their own where the parser attaches them again: before their item's
+//! keyword, before the field or op they preceded, or before the closing `}`.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use glam::Vec3;
 
-use crate::scene::{Camera, Graph, MaterialKeyword, NodeId, NodeKind, Scene, TransformOp};
+use crate::scene::{Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Scene, TransformOp};
 
 const IND: &str = "    ";
 /// Indentation stops growing past this depth, so a file with tens of thousands of nested
@@ -27,66 +30,142 @@ fn v3(v: Vec3) -> String {
 
 /// True when the scene can be written in the course's own grammar: it uses none of
 /// tracelab's extensions (Box, Union, Intersection, Subtraction), which are written only
-/// when used. (The slides' Material-in-Group shorthand is always written back canonically.)
+/// when used. (The slides' Material-in-Group shorthand is always written back canonically;
+/// `#` comments are written back only where the file read had them.)
 pub fn uses_only_course_grammar(scene: &Scene) -> bool {
     !scene.graph.iter().any(|(_, n)| n.kind.is_extension())
 }
 
+fn comment_lines(out: &mut String, ind: &str, lines: &[String]) {
+    for l in lines {
+        let _ = writeln!(out, "{ind}#{l}");
+    }
+}
+
+/// An item's inner comments, each written once before its line; whatever no line took (a
+/// field since removed by an edit) is written before the closing `}` rather than dropped.
+struct Inner<'a>(BTreeMap<&'a Anchor, &'a Vec<String>>);
+
+impl<'a> Inner<'a> {
+    fn new(c: &'a Comments) -> Self {
+        Inner(c.inner.iter().collect())
+    }
+
+    fn at(&mut self, out: &mut String, ind: &str, anchor: &Anchor) {
+        if let Some(lines) = self.0.remove(anchor) {
+            comment_lines(out, ind, lines);
+        }
+    }
+
+    fn field(&mut self, out: &mut String, ind: &str, name: &str) {
+        if !self.0.is_empty() {
+            self.at(out, ind, &Anchor::Field(name.to_string()));
+        }
+    }
+
+    /// The leftovers and the end comments, at the block's inner indentation.
+    fn finish(self, out: &mut String, ind: &str, end: &[String]) {
+        for lines in self.0.into_values() {
+            comment_lines(out, ind, lines);
+        }
+        comment_lines(out, ind, end);
+    }
+}
+
 pub fn write_scene(scene: &Scene) -> String {
     let mut out = String::new();
-    write_camera(&mut out, &scene.camera);
+    let sc = &scene.comments;
+    write_camera(&mut out, &scene.camera, &sc.camera);
     if let Some(lights) = &scene.lights {
-        out.push_str("\nLights {\n");
+        out.push('\n');
+        comment_lines(&mut out, "", &sc.lights.before);
+        out.push_str("Lights {\n");
+        let mut inner = Inner::new(&sc.lights);
+        inner.field(&mut out, IND, "numLights");
         let _ = writeln!(out, "{IND}numLights {}", lights.len());
+        let in2 = format!("{IND}{IND}");
         for l in lights {
+            comment_lines(&mut out, IND, &l.comments.before);
             let _ = writeln!(out, "{IND}DirectionalLight {{");
-            let _ = writeln!(out, "{IND}{IND}direction {}", v3(l.direction));
-            let _ = writeln!(out, "{IND}{IND}color {}", v3(l.color));
+            let mut li = Inner::new(&l.comments);
+            li.field(&mut out, &in2, "direction");
+            let _ = writeln!(out, "{in2}direction {}", v3(l.direction));
+            li.field(&mut out, &in2, "color");
+            let _ = writeln!(out, "{in2}color {}", v3(l.color));
+            li.finish(&mut out, &in2, &l.comments.end);
             let _ = writeln!(out, "{IND}}}");
         }
+        inner.finish(&mut out, IND, &sc.lights.end);
         out.push_str("}\n");
+    } else if !sc.lights.is_empty() {
+        // No Lights block to hold them (writing one would light the scene): keep them here.
+        out.push('\n');
+        comment_lines(&mut out, "", &sc.lights.lines().cloned().collect::<Vec<_>>());
     }
     let bg = &scene.background;
-    if bg.color.is_some() || bg.ambient.is_some() {
-        out.push_str("\nBackground {\n");
+    if bg.color.is_some() || bg.ambient.is_some() || !sc.background.is_empty() {
+        out.push('\n');
+        comment_lines(&mut out, "", &sc.background.before);
+        out.push_str("Background {\n");
+        let mut inner = Inner::new(&sc.background);
         if let Some(c) = bg.color {
+            inner.field(&mut out, IND, "color");
             let _ = writeln!(out, "{IND}color {}", v3(c));
         }
         if let Some(a) = bg.ambient {
+            inner.field(&mut out, IND, "ambientLight");
             let _ = writeln!(out, "{IND}ambientLight {}", v3(a));
         }
+        inner.finish(&mut out, IND, &sc.background.end);
         out.push_str("}\n");
     }
-    out.push_str("\nMaterials {\n");
+    out.push('\n');
+    comment_lines(&mut out, "", &sc.materials.before);
+    out.push_str("Materials {\n");
+    let mut inner = Inner::new(&sc.materials);
+    inner.field(&mut out, IND, "numMaterials");
     let _ = writeln!(out, "{IND}numMaterials {}", scene.materials.len());
+    let in2 = format!("{IND}{IND}");
     for m in &scene.materials {
         let kw = match m.keyword {
             MaterialKeyword::Material => "Material",
             MaterialKeyword::PhongMaterial => "PhongMaterial",
         };
+        comment_lines(&mut out, IND, &m.comments.before);
         let _ = writeln!(out, "{IND}{kw} {{");
-        let _ = writeln!(out, "{IND}{IND}diffuseColor {}", v3(m.diffuse));
+        let mut mi = Inner::new(&m.comments);
+        mi.field(&mut out, &in2, "diffuseColor");
+        let _ = writeln!(out, "{in2}diffuseColor {}", v3(m.diffuse));
         for (name, values) in &m.extra {
             let vals: Vec<String> = values.iter().map(|&v| num(v)).collect();
-            let _ = writeln!(out, "{IND}{IND}{name} {}", vals.join(" "));
+            mi.field(&mut out, &in2, name);
+            let _ = writeln!(out, "{in2}{name} {}", vals.join(" "));
         }
+        mi.finish(&mut out, &in2, &m.comments.end);
         let _ = writeln!(out, "{IND}}}");
     }
+    inner.finish(&mut out, IND, &sc.materials.end);
     out.push_str("}\n\n");
     write_graph(&mut out, &scene.graph);
+    comment_lines(&mut out, "", &sc.end);
     out
 }
 
-fn write_camera(out: &mut String, cam: &Camera) {
+fn write_camera(out: &mut String, cam: &Camera, comments: &Comments) {
     let (kw, last, value) = match cam {
         Camera::Orthographic { size, .. } => ("OrthographicCamera", "size", *size),
         Camera::Perspective { angle, .. } => ("PerspectiveCamera", "angle", *angle),
     };
+    comment_lines(out, "", &comments.before);
     let _ = writeln!(out, "{kw} {{");
-    let _ = writeln!(out, "{IND}center {}", v3(cam.center()));
-    let _ = writeln!(out, "{IND}direction {}", v3(cam.direction()));
-    let _ = writeln!(out, "{IND}up {}", v3(cam.up()));
+    let mut inner = Inner::new(comments);
+    for (name, v) in [("center", cam.center()), ("direction", cam.direction()), ("up", cam.up())] {
+        inner.field(out, IND, name);
+        let _ = writeln!(out, "{IND}{name} {}", v3(v));
+    }
+    inner.field(out, IND, last);
     let _ = writeln!(out, "{IND}{last} {}", num(value));
+    inner.finish(out, IND, &comments.end);
     out.push_str("}\n");
 }
 
@@ -113,20 +192,22 @@ fn write_op(out: &mut String, ind: &str, op: &TransformOp) {
 }
 
 enum Work {
-    Open { id: NodeId, depth: usize, in_group: bool },
+    /// `before_written`: the node's leading comments are already out (in a Group they go
+    /// above the MaterialIndex written for the node, where the parser takes them back).
+    Open { id: NodeId, depth: usize, in_group: bool, before_written: bool },
     Text(String),
 }
 
 /// Depth-first with an explicit stack, so deep trees cannot overflow the call stack.
 fn write_graph(out: &mut String, graph: &Graph) {
-    let mut stack = vec![Work::Open { id: graph.root(), depth: 0, in_group: false }];
+    let mut stack = vec![Work::Open { id: graph.root(), depth: 0, in_group: false, before_written: false }];
     while let Some(w) = stack.pop() {
-        let (id, depth, in_group) = match w {
+        let (id, depth, in_group, before_written) = match w {
             Work::Text(t) => {
                 out.push_str(&t);
                 continue;
             }
-            Work::Open { id, depth, in_group } => (id, depth, in_group),
+            Work::Open { id, depth, in_group, before_written } => (id, depth, in_group, before_written),
         };
         let Some(node) = graph.get(id) else { continue };
         let mut depth = depth;
@@ -144,10 +225,22 @@ fn write_graph(out: &mut String, graph: &Graph) {
         }
         let ind = indent(depth);
         let inner = format!("{ind}{IND}");
+        if !before_written {
+            comment_lines(out, &ind, &node.comments.before);
+        }
+        let mut ic = Inner::new(&node.comments);
+        // The node's own `}`, after its leftover and end comments.
+        let own_closer = |ic: Inner| {
+            let mut s = String::new();
+            ic.finish(&mut s, &inner, &node.comments.end);
+            let _ = writeln!(s, "{ind}}}");
+            s
+        };
         let _ = writeln!(out, "{ind}{} {{", node.kind.name());
         match &node.kind {
             NodeKind::Group | NodeKind::Csg(_) => {
                 if node.kind == NodeKind::Group {
+                    ic.field(out, &inner, "numObjects");
                     let _ = writeln!(out, "{inner}numObjects {}", node.children.len());
                 }
                 // Emit MaterialIndex where a child's own material changes. A block starts
@@ -156,16 +249,22 @@ fn write_graph(out: &mut String, graph: &Graph) {
                 let mut current = None;
                 let mut work = Vec::new();
                 for &c in &node.children {
-                    let want = graph.get(c).and_then(|n| n.material);
+                    let child = graph.get(c);
+                    if let Some(before) = child.map(|n| &n.comments.before).filter(|b| !b.is_empty()) {
+                        let mut t = String::new();
+                        comment_lines(&mut t, &inner, before);
+                        work.push(Work::Text(t));
+                    }
+                    let want = child.and_then(|n| n.material);
                     if let Some(m) = want
                         && current != Some(m)
                     {
                         work.push(Work::Text(format!("{inner}MaterialIndex {m}\n")));
                         current = Some(m);
                     }
-                    work.push(Work::Open { id: c, depth: depth + 1, in_group: true });
+                    work.push(Work::Open { id: c, depth: depth + 1, in_group: true, before_written: true });
                 }
-                closers.insert(0, format!("{ind}}}\n"));
+                closers.insert(0, own_closer(ic));
                 for c in closers.into_iter().rev() {
                     stack.push(Work::Text(c));
                 }
@@ -173,37 +272,50 @@ fn write_graph(out: &mut String, graph: &Graph) {
                 continue;
             }
             NodeKind::Transform(ops) => {
-                for op in ops {
+                for (i, op) in ops.iter().enumerate() {
+                    ic.at(out, &inner, &Anchor::Op(i));
                     write_op(out, &inner, op);
                 }
-                closers.insert(0, format!("{ind}}}\n"));
+                closers.insert(0, own_closer(ic));
                 for c in closers.into_iter().rev() {
                     stack.push(Work::Text(c));
                 }
                 for &c in node.children.iter().rev() {
-                    stack.push(Work::Open { id: c, depth: depth + 1, in_group: false });
+                    stack.push(Work::Open { id: c, depth: depth + 1, in_group: false, before_written: false });
                 }
                 continue;
             }
             NodeKind::Sphere { center, radius } => {
-                let _ = writeln!(out, "{inner}center {}\n{inner}radius {}", v3(*center), num(*radius));
+                ic.field(out, &inner, "center");
+                let _ = writeln!(out, "{inner}center {}", v3(*center));
+                ic.field(out, &inner, "radius");
+                let _ = writeln!(out, "{inner}radius {}", num(*radius));
             }
             NodeKind::Plane { normal, offset } => {
-                let _ = writeln!(out, "{inner}normal {}\n{inner}offset {}", v3(*normal), num(*offset));
+                ic.field(out, &inner, "normal");
+                let _ = writeln!(out, "{inner}normal {}", v3(*normal));
+                ic.field(out, &inner, "offset");
+                let _ = writeln!(out, "{inner}offset {}", num(*offset));
             }
             NodeKind::Triangle { vertices } => {
                 for (i, v) in vertices.iter().enumerate() {
-                    let _ = writeln!(out, "{inner}vertex{i} {}", v3(*v));
+                    let name = format!("vertex{i}");
+                    ic.field(out, &inner, &name);
+                    let _ = writeln!(out, "{inner}{name} {}", v3(*v));
                 }
             }
             NodeKind::TriangleMesh { obj_file, .. } => {
+                ic.field(out, &inner, "obj_file");
                 let _ = writeln!(out, "{inner}obj_file {obj_file}");
             }
             NodeKind::Box { min, max } => {
-                let _ = writeln!(out, "{inner}min {}\n{inner}max {}", v3(*min), v3(*max));
+                ic.field(out, &inner, "min");
+                let _ = writeln!(out, "{inner}min {}", v3(*min));
+                ic.field(out, &inner, "max");
+                let _ = writeln!(out, "{inner}max {}", v3(*max));
             }
         }
-        let _ = writeln!(out, "{ind}}}");
+        out.push_str(&own_closer(ic));
         for c in closers {
             out.push_str(&c);
         }

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::{MeshSlot, TransformOp};
+use super::{Comments, MeshSlot, TransformOp};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct NodeId(pub u32);
@@ -100,11 +100,14 @@ pub struct Node {
     /// the material in effect around it.
     pub material: Option<u32>,
     pub children: Vec<NodeId>,
+    /// `#` comments written before, inside and at the end of this node's block; a deleted
+    /// node takes them with it.
+    pub comments: Comments,
 }
 
 impl Node {
     pub fn new(kind: NodeKind) -> Self {
-        Node { kind, material: None, children: Vec::new() }
+        Node { kind, material: None, children: Vec::new(), comments: Comments::default() }
     }
 }
 
@@ -242,6 +245,7 @@ impl Graph {
                 Node {
                     kind: n.kind.clone(),
                     material: n.material,
+                    comments: n.comments.clone(),
                     children: n.children.iter().map(|c| NodeId(new_id[c.index()])).collect(),
                 }
             })

@@ -2,10 +2,12 @@
 //! Plain data: the parser builds it, the writer prints it, the GUI edits it, the renderer
 //! compiles a snapshot of it.
 
+mod comments;
 mod graph;
 mod mesh;
 mod transform;
 
+pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, check_closed};
 pub use transform::{TransformOp, compose};
@@ -55,6 +57,13 @@ impl Camera {
 pub struct Light {
     pub direction: Vec3,
     pub color: Vec3,
+    pub comments: Comments,
+}
+
+impl Light {
+    pub fn new(direction: Vec3, color: Vec3) -> Self {
+        Light { direction, color, comments: Comments::default() }
+    }
 }
 
 /// `Background { color ambientLight }`; either field may be absent in a file, and absent
@@ -79,11 +88,12 @@ pub struct Material {
     pub keyword: MaterialKeyword,
     /// Fields tracelab does not shade with (specularColor, exponent, ...), kept for the writer.
     pub extra: Vec<(String, Vec<f32>)>,
+    pub comments: Comments,
 }
 
 impl Material {
     pub fn diffuse(diffuse: Vec3) -> Self {
-        Material { diffuse, keyword: MaterialKeyword::Material, extra: Vec::new() }
+        Material { diffuse, keyword: MaterialKeyword::Material, extra: Vec::new(), comments: Comments::default() }
     }
 }
 
@@ -99,6 +109,9 @@ pub struct Scene {
     pub background: Background,
     pub materials: Vec<Material>,
     pub graph: Graph,
+    /// `#` comments of the top-level blocks and the end of the file (the others are on the
+    /// nodes, lights and materials they were written next to).
+    pub comments: SceneComments,
 }
 
 impl Default for Scene {
@@ -109,6 +122,7 @@ impl Default for Scene {
             background: Background::default(),
             materials: Vec::new(),
             graph: Graph::new(),
+            comments: SceneComments::default(),
         }
     }
 }
