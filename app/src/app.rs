@@ -225,9 +225,7 @@ impl TracelabApp {
                 } else {
                     path.to_path_buf()
                 };
-                frame
-                    .save(*view, depth, &target)
-                    .map_err(|e| format!("{}: {e}", target.display()))?;
+                crate::io::write_image(&frame, *view, depth, &target)?;
                 written.push(target);
             }
             Ok(written)

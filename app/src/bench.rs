@@ -16,7 +16,7 @@ use tracelab_core::{
     render_progressive,
 };
 
-use crate::cli::{BenchArgs, CliError, ProgressiveArgs, load};
+use crate::cli::{BenchArgs, CliError, ProgressiveArgs, check_size, load};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -25,6 +25,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 pub fn run(b: &BenchArgs) -> Result<(), CliError> {
     let (w, h) = (b.size[0], b.size[1]);
+    check_size(w, h)?;
     let t_load = Instant::now();
     let scene = load(Some(&b.scene))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
@@ -185,6 +186,7 @@ fn distinct_meshes(scene: &Scene) -> Vec<Arc<Mesh>> {
 /// to the last, full-resolution pass of the progressive renderer, as the GUI drives it.
 pub fn run_progressive(b: &ProgressiveArgs) -> Result<(), CliError> {
     let (w, h) = (b.size[0], b.size[1]);
+    check_size(w, h)?;
     let scene = load(Some(&b.scene))?;
     let settings = RenderSettings {
         width: w,

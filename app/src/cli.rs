@@ -2,7 +2,8 @@
 //!
 //! Exit codes: 0 success, 1 scene or I/O error, 2 usage error.
 
-use std::io::IsTerminal;
+use std::ffi::{OsStr, OsString};
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -10,7 +11,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand, ValueEnum};
-use tracelab_core::render::{SharedFrame, render_full};
+use tracelab_core::render::{SharedFrame, check_image_size, render_full};
 use tracelab_core::{CompiledScene, MeshCache, NormalTransform, RenderSettings, Scene, View};
 
 #[derive(Parser, Debug)]
@@ -22,7 +23,8 @@ use tracelab_core::{CompiledScene, MeshCache, NormalTransform, RenderSettings, S
         With no arguments, opens the editor on a built-in scene; with a SCENE, opens that file.\n\
         The course's own command lines work unchanged, e.g.\n  \
         tracelab -input scene2_05_inside_sphere.txt -size 200 200 -output out.tga \\\n    \
-        -depth 9 11 depth.tga -normals normals.tga -shade_back",
+        -depth 9 11 depth.tga -normals normals.tga -shade_back\n\n\
+        Images are at most 16384 pixels a side and 67108864 (8192x8192) pixels in all.",
     args_conflicts_with_subcommands = true
 )]
 pub struct Cli {
@@ -53,8 +55,8 @@ pub enum Command {
 pub struct RenderArgs {
     /// Scene file (default: the built-in scene).
     pub scene: Option<PathBuf>,
-    /// Image size in pixels.
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [400u32, 400])]
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [400u32, 400], allow_negative_numbers = true)]
     pub size: Vec<u32>,
     /// Colour image.
     #[arg(long, short)]
@@ -62,9 +64,9 @@ pub struct RenderArgs {
     /// Normal image: |n| of the world normal as RGB.
     #[arg(long)]
     pub normals: Option<PathBuf>,
-    /// Depth image: t in [MIN, MAX] mapped to white..black.
-    #[arg(long, num_args = 3, value_names = ["MIN", "MAX", "FILE"])]
-    pub depth: Option<Vec<String>>,
+    /// Depth image: t in [MIN, MAX] mapped to white..black (MIN may be negative).
+    #[arg(long, num_args = 3, value_names = ["MIN", "MAX", "FILE"], allow_negative_numbers = true)]
+    pub depth: Option<Vec<OsString>>,
     /// Shade back-facing surfaces with the flipped normal instead of black.
     #[arg(long)]
     pub shade_back: bool,
@@ -76,11 +78,12 @@ pub struct RenderArgs {
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
     pub scene: PathBuf,
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800])]
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
     pub size: Vec<u32>,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub threads: usize,
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub repeat: usize,
     /// Trace 4x2 pixel tiles as 8-ray packets (as Embree's rtcIntersect8 loop does).
     #[arg(long)]
@@ -90,12 +93,13 @@ pub struct BenchArgs {
 #[derive(clap::Args, Debug)]
 pub struct ProgressiveArgs {
     pub scene: PathBuf,
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800])]
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
     pub size: Vec<u32>,
     /// Threads (default: all cores, as the GUI uses).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub threads: Option<usize>,
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
     pub repeat: usize,
 }
 
@@ -148,14 +152,15 @@ impl CliError {
 }
 
 pub fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().collect();
+    // args_os: a file name need not be UTF-8.
+    let args: Vec<OsString> = std::env::args_os().collect();
     let result = run(&args);
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             match &e {
-                CliError::Usage(m) => eprintln!("tracelab: {m}\nTry 'tracelab --help'."),
-                CliError::Failed(m) => eprint!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }),
+                CliError::Usage(m) => print_err(&format!("tracelab: {m}\nTry 'tracelab --help'.\n")),
+                CliError::Failed(m) => print_err(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" })),
                 CliError::UsagePrinted => {}
             }
             e.code()
@@ -163,10 +168,15 @@ pub fn main() -> ExitCode {
     }
 }
 
-pub fn run(args: &[String]) -> Result<(), CliError> {
+/// Writes to standard error; with standard error closed or full there is no one left to tell.
+fn print_err(text: &str) {
+    let _ = std::io::stderr().lock().write_all(text.as_bytes());
+}
+
+pub fn run(args: &[OsString]) -> Result<(), CliError> {
     // The course's raytracer flags start with a single dash: `-input`, `-size`, ...
     if args.iter().skip(1).any(|a| a == "-input") {
-        let job = parse_course_args(&args[1..])?;
+        let job = parse_course_args(args.get(1..).unwrap_or_default())?;
         return run_render(&job);
     }
     let cli = match Cli::try_parse_from(args) {
@@ -199,15 +209,16 @@ fn render_job(r: RenderArgs) -> Result<RenderJob, CliError> {
     let depth = match r.depth {
         None => None,
         Some(v) => {
-            let min = parse_f32(&v[0], "--depth MIN")?;
-            let max = parse_f32(&v[1], "--depth MAX")?;
-            Some((min, max, PathBuf::from(&v[2])))
+            let [min, max, file] = v.as_slice() else {
+                return Err(CliError::Usage("--depth needs MIN MAX FILE".into()));
+            };
+            Some((parse_f32(min, "--depth MIN")?, parse_f32(max, "--depth MAX")?, PathBuf::from(file)))
         }
     };
     let job = RenderJob {
         scene: r.scene,
-        width: r.size[0],
-        height: r.size[1],
+        width: r.size.first().copied().unwrap_or(0),
+        height: r.size.get(1).copied().unwrap_or(0),
         output: r.output,
         normals: r.normals,
         depth,
@@ -220,23 +231,28 @@ fn render_job(r: RenderArgs) -> Result<RenderJob, CliError> {
     Ok(job)
 }
 
-fn parse_f32(s: &str, what: &str) -> Result<f32, CliError> {
-    s.parse::<f32>()
-        .ok()
+fn parse_f32(s: &OsStr, what: &str) -> Result<f32, CliError> {
+    s.to_str()
+        .and_then(|t| t.parse::<f32>().ok())
         .filter(|v| v.is_finite())
-        .ok_or_else(|| CliError::Usage(format!("{what}: expected a number, found \"{s}\"")))
+        .ok_or_else(|| CliError::Usage(format!("{what}: expected a number, found \"{}\"", s.display())))
 }
 
-fn parse_u32(s: &str, what: &str) -> Result<u32, CliError> {
-    s.parse::<u32>()
-        .ok()
+fn parse_u32(s: &OsStr, what: &str) -> Result<u32, CliError> {
+    s.to_str()
+        .and_then(|t| t.parse::<u32>().ok())
         .filter(|&v| v > 0)
-        .ok_or_else(|| CliError::Usage(format!("{what}: expected a positive whole number, found \"{s}\"")))
+        .ok_or_else(|| CliError::Usage(format!("{what}: expected a positive whole number, found \"{}\"", s.display())))
+}
+
+/// The size limit of `tracelab_core::render::check_image_size`, as a usage error.
+pub fn check_size(width: u32, height: u32) -> Result<(), CliError> {
+    check_image_size(width, height).map_err(|e| CliError::Usage(e.to_string()))
 }
 
 /// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
 /// -shade_back`, plus tracelab's `-normal_transform correct|incorrect`.
-pub fn parse_course_args(args: &[String]) -> Result<RenderJob, CliError> {
+pub fn parse_course_args(args: &[OsString]) -> Result<RenderJob, CliError> {
     let mut job = RenderJob {
         scene: None,
         width: 0,
@@ -248,11 +264,13 @@ pub fn parse_course_args(args: &[String]) -> Result<RenderJob, CliError> {
         normal_transform: NormalTransform::Correct,
     };
     let mut it = args.iter();
-    let take = |it: &mut std::slice::Iter<String>, flag: &str| -> Result<String, CliError> {
+    let take = |it: &mut std::slice::Iter<OsString>, flag: &str| -> Result<OsString, CliError> {
         it.next().cloned().ok_or_else(|| CliError::Usage(format!("{flag} needs a value")))
     };
-    while let Some(a) = it.next() {
-        match a.as_str() {
+    while let Some(arg) = it.next() {
+        // Flags are ASCII; a value after one may be any bytes (a file name).
+        let a = arg.to_str().unwrap_or_default();
+        match a {
             "-input" => job.scene = Some(PathBuf::from(take(&mut it, a)?)),
             "-size" => {
                 job.width = parse_u32(&take(&mut it, a)?, "-size width")?;
@@ -267,13 +285,14 @@ pub fn parse_course_args(args: &[String]) -> Result<RenderJob, CliError> {
             }
             "-shade_back" => job.shade_back = true,
             "-normal_transform" => {
-                job.normal_transform = match take(&mut it, a)?.as_str() {
-                    "correct" => NormalTransform::Correct,
-                    "incorrect" => NormalTransform::Incorrect,
-                    other => return Err(CliError::Usage(format!("-normal_transform: expected correct or incorrect, found \"{other}\""))),
+                let v = take(&mut it, a)?;
+                job.normal_transform = match v.to_str() {
+                    Some("correct") => NormalTransform::Correct,
+                    Some("incorrect") => NormalTransform::Incorrect,
+                    _ => return Err(CliError::Usage(format!("-normal_transform: expected correct or incorrect, found \"{}\"", v.display()))),
                 }
             }
-            other => return Err(CliError::Usage(format!("unknown option \"{other}\" (course flags: -input -size -output -normals -depth -shade_back)"))),
+            _ => return Err(CliError::Usage(format!("unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back)", arg.display()))),
         }
     }
     if job.scene.is_none() {
@@ -304,10 +323,9 @@ pub fn load(path: Option<&Path>) -> Result<Scene, CliError> {
 }
 
 fn check_extension(path: &Path) -> Result<(), CliError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("png" | "tga" | "ppm" | "pnm" | "bmp") => Ok(()),
-        _ => Err(CliError::Usage(format!(
+    match crate::io::image_format(path) {
+        Some(_) => Ok(()),
+        None => Err(CliError::Usage(format!(
             "{}: unknown image format (use .png, .tga, .ppm or .bmp)",
             path.display()
         ))),
@@ -318,6 +336,8 @@ pub fn run_render(job: &RenderJob) -> Result<(), CliError> {
     for p in [&job.output, &job.normals].into_iter().flatten().chain(job.depth.as_ref().map(|d| &d.2)) {
         check_extension(p)?;
     }
+    // Before loading, and long before allocating the frame.
+    check_size(job.width, job.height)?;
     let scene = load(job.scene.as_deref())?;
     let compiled = CompiledScene::new(&scene);
     let settings = RenderSettings {
@@ -328,9 +348,7 @@ pub fn run_render(job: &RenderJob) -> Result<(), CliError> {
     };
     let frame = render_with_progress(&compiled, &settings);
     let save = |view: View, depth: (f32, f32), path: &Path| {
-        frame
-            .save(view, depth, path)
-            .map_err(|e| CliError::Failed(format!("{}: cannot write image: {e}", path.display())))
+        crate::io::write_image(&frame, view, depth, path).map_err(CliError::Failed)
     };
     if let Some(p) = &job.output {
         save(View::Color, (0.0, 1.0), p)?;
@@ -388,25 +406,21 @@ fn run_fmt(scene: &Path, output: Option<&Path>) -> Result<(), CliError> {
     }
     let text = tracelab_core::write_scene(&s);
     match output {
-        None => {
-            print!("{text}");
-            Ok(())
-        }
-        Some(out) => write_atomic(out, text.as_bytes())
+        None => write_stdout(text.as_bytes()),
+        Some(out) => crate::io::write_atomic(out, text.as_bytes())
             .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", out.display()))),
     }
 }
 
-/// Writes via a temporary file in the same folder and a rename, so a failure never leaves a
-/// half-written file behind.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tracelab-tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+/// Writes to standard output, checking the write and the flush: a reader that closed the
+/// pipe (`| head`) wanted no more, which is no error; anything else (a full disk) is.
+fn write_stdout(bytes: &[u8]) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(CliError::Failed(format!("standard output: cannot write: {e}"))),
+    }
 }
 
 fn with_threads(threads: usize, f: impl FnOnce() -> Result<(), CliError> + Send) -> Result<(), CliError> {

@@ -255,7 +255,7 @@ impl Document {
         let mut scene = self.scene.clone();
         tracelab_core::rebase_mesh_paths(&mut scene, &from, &to);
         let text = tracelab_core::write_scene(&scene);
-        crate::cli::write_atomic(path, text.as_bytes())
+        crate::io::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
         self.scene = scene;
         for s in self.undo.iter_mut().chain(self.redo.iter_mut()) {
@@ -349,5 +349,105 @@ mod tests {
         let w = doc.save_warnings(&d.join("scenes/s.txt"));
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("s.txt:2:") && w[0].contains("comment"), "{w:?}");
+
+    fn empty_dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("tracelab-state-io-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("temp dir");
+        d
+    }
+
+
+    fn names_in(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .expect("read dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn save_keeps_a_private_files_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = empty_dir("mode");
+        let p = d.join("scene.txt");
+        std::fs::write(&p, crate::DEFAULT_SCENE).expect("write");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o600)).expect("chmod");
+        let mut doc = Document::builtin();
+        doc.open(&p).expect("open");
+        doc.save().expect("save");
+        assert_eq!(std::fs::metadata(&p).expect("meta").permissions().mode() & 0o7777, 0o600);
+        assert_eq!(names_in(&d), ["scene.txt"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn save_writes_through_a_symlink_to_its_target() {
+        let d = empty_dir("link");
+        std::fs::create_dir(d.join("real")).expect("mkdir");
+        std::fs::write(d.join("real/scene.txt"), crate::DEFAULT_SCENE).expect("write");
+        std::os::unix::fs::symlink("real/scene.txt", d.join("link.txt")).expect("symlink");
+        let mut doc = Document::builtin();
+        doc.open(&d.join("link.txt")).expect("open");
+        doc.scene.background.color = Some(glam::Vec3::new(0.25, 0.5, 0.75));
+        doc.save().expect("save");
+        assert!(std::fs::symlink_metadata(d.join("link.txt")).expect("meta").file_type().is_symlink());
+        let text = std::fs::read_to_string(d.join("real/scene.txt")).expect("read");
+        assert!(text.contains("0.25 0.5 0.75"), "{text}");
+        assert_eq!(names_in(&d), ["link.txt", "real"]);
+        assert_eq!(names_in(&d.join("real")), ["scene.txt"]);
+    }
+
+    #[test]
+    fn a_failed_save_keeps_the_old_file_the_path_and_no_temporary_file() {
+        let d = empty_dir("fail");
+        let p = d.join("scene.txt");
+        std::fs::write(&p, crate::DEFAULT_SCENE).expect("write");
+        let mut doc = Document::builtin();
+        doc.open(&p).expect("open");
+        let e = doc.save_as(&d.join("gone/scene.txt")).expect_err("no such folder");
+        assert!(e.contains("cannot write"), "{e}");
+        assert_eq!(doc.path.as_deref(), Some(p.as_path()));
+        assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);
+        assert_eq!(names_in(&d), ["scene.txt"]);
+    }
+
+    /// A folder that refuses new files even to root (`chattr +i`, ext4 and similar), or to
+    /// anyone else (mode 0555); undone on drop.
+    #[cfg(unix)]
+    struct LockedDir(PathBuf);
+
+    #[cfg(unix)]
+    impl Drop for LockedDir {
+        fn drop(&mut self) {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::process::Command::new("chattr").arg("-i").arg(&self.0).status();
+            let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_save_into_a_locked_folder_fails_and_keeps_the_old_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = empty_dir("locked");
+        let p = d.join("scene.txt");
+        std::fs::write(&p, "old text").expect("write");
+        let mut doc = Document::builtin();
+        doc.path = Some(p.clone());
+        let lock = LockedDir(d.clone());
+        std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o555)).expect("chmod");
+        let _ = std::process::Command::new("chattr").arg("+i").arg(&d).status();
+        if std::fs::File::create(d.join("probe")).is_ok() {
+            let _ = std::fs::remove_file(d.join("probe"));
+            eprintln!("SKIPPED: cannot make a folder that refuses new files here (root without chattr)");
+            return;
+        }
+        assert!(doc.save().is_err(), "saving into a locked folder fails");
+        drop(lock);
+        assert_eq!(std::fs::read_to_string(&p).expect("read"), "old text");
+        assert_eq!(names_in(&d), ["scene.txt"]);
     }
 }

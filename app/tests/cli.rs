@@ -133,6 +133,183 @@ fn fmt_keeps_comments() {
     }
 }
 
+// ---- Robustness (issue 11): sizes, non-UTF-8 arguments, pipes, full devices, writes ----
+
+/// A private device node (never the machine's own /dev files); `None`, with a message,
+/// where mknod is not allowed.
+#[cfg(unix)]
+fn mknod(dir: &Path, name: &str, minor: u32) -> Option<PathBuf> {
+    let p = dir.join(name);
+    let ok = Command::new("mknod").arg(&p).args(["c", "1", &minor.to_string()]).status().is_ok_and(|s| s.success());
+    if !ok {
+        eprintln!("SKIPPED: mknod is not allowed here, cannot make a private device node");
+        return None;
+    }
+    Some(p)
+}
+
+#[cfg(unix)]
+fn is_char_device(p: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_char_device())
+}
+
+#[test]
+fn image_sizes_over_the_limit_or_zero_are_usage_errors_before_any_allocation() {
+    let d = temp_dir("sizes");
+    std::fs::write(d.join("o.png"), "old").expect("write");
+    for size in [["100000", "100000"], ["4294967295", "4294967295"], ["0", "0"], ["16384", "16384"]] {
+        let o = tracelab(&["render", "--size", size[0], size[1], "--output", "o.png"], &d);
+        assert_eq!(o.status.code(), Some(2), "--size {size:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("image size"), "{}", stderr(&o));
+    }
+    let o = tracelab(&["-input", "x.txt", "-size", "100000", "100000", "-output", "o.png"], &d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(std::fs::read(d.join("o.png")).expect("read"), b"old", "the old image is untouched");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let scene = scene.to_str().expect("utf-8 path");
+    for cmd in ["bench", "bench-progressive"] {
+        let o = tracelab(&[cmd, scene, "--size", "0", "0"], &d);
+        assert_eq!(o.status.code(), Some(2), "{cmd}: {}", stderr(&o));
+        assert!(stderr(&o).contains("image size 0x0"), "{}", stderr(&o));
+    }
+    let help = String::from_utf8_lossy(&tracelab(&["--help"], &d).stdout).to_string();
+    assert!(help.contains("16384 pixels a side"), "{help}");
+    assert_eq!((tracelab_core::render::MAX_IMAGE_SIDE, tracelab_core::render::MAX_IMAGE_PIXELS), (16384, 8192 * 8192), "--help states these numbers");
+}
+
+#[cfg(unix)]
+#[test]
+fn non_utf8_file_names_are_paths_not_panics() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let d = temp_dir("nonutf8");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let odd = OsStr::from_bytes(b"\xffodd.png");
+    let run = |args: &[&OsStr]| Command::new(env!("CARGO_BIN_EXE_tracelab")).args(args).current_dir(&d).output().expect("run");
+    let o = run(&[OsStr::new("render"), scene.as_os_str(), OsStr::new("--size"), OsStr::new("8"), OsStr::new("8"), OsStr::new("--output"), odd]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(d.join(odd).is_file());
+    let o = run(&[OsStr::new("-input"), scene.as_os_str(), OsStr::new("-size"), OsStr::new("8"), OsStr::new("8"), OsStr::new("-depth"), OsStr::new("1"), OsStr::new("9"), OsStr::from_bytes(b"\xfed.png")]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = run(&[OsStr::new("fmt"), OsStr::from_bytes(b"\xffmissing.txt")]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let o = run(&[OsStr::new("-input"), OsStr::new("x.txt"), OsStr::new("-size"), OsStr::from_bytes(b"\xff"), OsStr::new("8")]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// A scene whose canonical text is far larger than a pipe's buffer.
+fn big_scene(d: &Path) -> PathBuf {
+    let mut s = String::from("OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\nMaterials { numMaterials 1 Material { diffuseColor 1 0 0 } }\nGroup { numObjects 4000 MaterialIndex 0\n");
+    for i in 0..4000 {
+        s.push_str(&format!("Sphere {{ center {i} 0 0 radius 1 }}\n"));
+    }
+    s.push_str("}\n");
+    let p = d.join("big.txt");
+    std::fs::write(&p, s).expect("write");
+    p
+}
+
+#[test]
+fn fmt_into_a_closed_pipe_ends_quietly() {
+    use std::io::Read;
+    let d = temp_dir("pipe");
+    let scene = big_scene(&d);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .arg("fmt")
+        .arg(&scene)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut head = [0u8; 10];
+    child.stdout.take().expect("stdout").read_exact(&mut head).expect("read 10 bytes"); // like `head -c 10`, then close
+    let o = child.wait_with_output().expect("wait");
+    assert_eq!(&head, b"Orthograph");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(o.stderr.is_empty(), "quiet: {}", stderr(&o));
+}
+
+#[cfg(unix)]
+#[test]
+fn fmt_to_a_full_standard_output_is_an_error() {
+    let d = temp_dir("stdout-full");
+    let Some(full) = mknod(&d, "full", 7) else { return };
+    let scene = big_scene(&d);
+    let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .arg("fmt")
+        .arg(&scene)
+        .stdout(std::fs::OpenOptions::new().write(true).open(&full).expect("open private full device"))
+        .output()
+        .expect("run");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("standard output: cannot write"), "{}", stderr(&o));
+    assert!(is_char_device(&full));
+}
+
+#[cfg(unix)]
+#[test]
+fn writing_to_a_full_device_fails_for_every_output_and_leaves_the_node() {
+    let d = temp_dir("full");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let scene = scene.to_str().expect("utf-8 path");
+    for ext in ["png", "tga", "ppm", "bmp"] {
+        let Some(full) = mknod(&d, &format!("full.{ext}"), 7) else { return };
+        let o = tracelab(&["render", scene, "--size", "8", "8", "--output", &format!("full.{ext}")], &d);
+        assert_eq!(o.status.code(), Some(1), "{ext}: {}", stderr(&o));
+        assert!(is_char_device(&full), "{ext}: still a device node");
+    }
+    let Some(full) = mknod(&d, "full.txt", 7) else { return };
+    let o = tracelab(&["fmt", scene, "-o", "full.txt"], &d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(is_char_device(&full), "fmt -o keeps the device node");
+    let Some(null) = mknod(&d, "null.txt", 3) else { return };
+    let o = tracelab(&["fmt", scene, "-o", "null.txt"], &d);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(is_char_device(&null), "fmt -o writes into a null device");
+}
+
+#[cfg(unix)]
+#[test]
+fn fmt_output_keeps_mode_and_symlinks_and_leaves_no_temporary_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = temp_dir("fmt-keep");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let scene = scene.to_str().expect("utf-8 path");
+    std::fs::write(d.join("private.txt"), "old").expect("write");
+    std::fs::set_permissions(d.join("private.txt"), std::fs::Permissions::from_mode(0o600)).expect("chmod");
+    assert!(tracelab(&["fmt", scene, "-o", "private.txt"], &d).status.success());
+    assert_eq!(std::fs::metadata(d.join("private.txt")).expect("meta").permissions().mode() & 0o777, 0o600);
+    std::fs::write(d.join("target.txt"), "old").expect("write");
+    std::os::unix::fs::symlink("target.txt", d.join("link.txt")).expect("symlink");
+    assert!(tracelab(&["fmt", scene, "-o", "link.txt"], &d).status.success());
+    assert!(std::fs::symlink_metadata(d.join("link.txt")).expect("meta").file_type().is_symlink());
+    assert!(std::fs::read_to_string(d.join("target.txt")).expect("read").contains("Camera"));
+    let mut names: Vec<_> = std::fs::read_dir(&d).expect("dir").map(|e| e.expect("entry").file_name().to_string_lossy().to_string()).collect();
+    names.sort();
+    assert_eq!(names, ["link.txt", "private.txt", "target.txt"]);
+}
+
+#[test]
+fn a_rejected_render_keeps_the_existing_image() {
+    let d = temp_dir("keep-image");
+    std::fs::write(d.join("o.png"), "old").expect("write");
+    let o = tracelab(&["render", "--size", "0", "0", "--output", "o.png"], &d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(std::fs::read(d.join("o.png")).expect("read"), b"old");
+}
+
+#[test]
+fn ppm_output_is_binary_ppm_p6() {
+    let d = temp_dir("p6");
+    for name in ["o.ppm", "o.pnm"] {
+        let o = tracelab(&["render", "--size", "5", "4", "--output", name], &d);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let bytes = std::fs::read(d.join(name)).expect("read");
+        assert!(bytes.starts_with(b"P6\n5 4 255\n"), "{name}: {:?}", String::from_utf8_lossy(&bytes[..bytes.len().min(16)]));
+    }
+}
+
 #[test]
 fn fmt_warns_about_a_comment_it_cannot_keep_before_writing() {
     let d = temp_dir("fmt-lost");
@@ -184,4 +361,18 @@ fn a_mesh_found_only_in_the_current_folder_is_reported() {
     assert!(o.status.success(), "{}", stderr(&o));
     // ...but says where the mesh came from.
     assert!(stderr(&o).contains("not in the scene's folder"), "{}", stderr(&o));
+}
+
+#[test]
+fn negative_depth_ranges_are_accepted_in_both_spellings() {
+    let d = temp_dir("negative");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let scene = scene.to_str().expect("utf-8 path");
+    let o = tracelab(&["render", scene, "--size", "8", "8", "--depth", "-1", "1", "d.png"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(d.join("d.png").is_file());
+    let o = tracelab(&["-input", scene, "-size", "8", "8", "-depth", "-1", "1", "e.png"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A negative size is now "invalid value", still a usage error.
+    assert_eq!(tracelab(&["render", "--size", "-1", "5", "--output", "x.png"], &d).status.code(), Some(2));
 }

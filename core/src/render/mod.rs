@@ -6,6 +6,7 @@ mod compile;
 pub mod csg;
 mod frame;
 mod inspect;
+mod limits;
 mod progressive;
 mod shade;
 
@@ -13,6 +14,7 @@ pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, Shape, Xf};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
+pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
 pub use progressive::{Cancelled, PassInfo, SharedFrame, render_frame, render_full, render_progressive};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 

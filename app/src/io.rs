@@ -1,0 +1,451 @@
+//! Writing files without losing them: every output of tracelab (rendered images, `fmt -o`,
+//! the editor's Save, Save As and Export view) goes through [`write_atomic`].
+//!
+//! A regular file (or a new one) is replaced atomically: the bytes go to an exclusively
+//! created temporary file with an unpredictable name in the target's own folder, which is
+//! flushed, given the old file's mode (and owner, as root), synced, renamed over the target,
+//! and the folder synced. On any failure the old file is untouched and the temporary file is
+//! removed. A symlink is followed and its target written, so the link stays a link. A device
+//! node or FIFO is not replaced but written into, and its errors (a full device) reported.
+//!
+//! Why `tempfile` and not Linux's `O_TMPFILE`: it builds on every platform the editor runs
+//! on and needs no `unsafe` or raw system calls; the cost is that a `kill -9` between
+//! creating and renaming leaves one `.tracelab-*.tmp` file in the target's folder.
+
+use std::fs::{File, Metadata};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+use tracelab_core::{Frame, View};
+
+/// Symlinks followed before giving up, as the kernel's own limit (`ELOOP`).
+const MAX_SYMLINKS: usize = 40;
+
+/// Replaces `path` with `bytes`, or writes them into it if it is a device or FIFO; see the
+/// module comment for the rules.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let (target, existing) = resolve_symlinks(path)?;
+    match &existing {
+        Some(meta) if meta.is_dir() => Err(io::Error::new(
+            io::ErrorKind::IsADirectory,
+            "is a directory",
+        )),
+        Some(meta) if !meta.is_file() => write_in_place(&target, bytes),
+        _ => replace(&target, existing.as_ref(), bytes),
+    }
+}
+
+/// Encodes one view of a frame in the format its extension names (see [`image_format`]),
+/// all in memory first so that a failed encode never touches an existing file, then writes
+/// it with [`write_atomic`].
+pub fn write_image(
+    frame: &Frame,
+    view: View,
+    depth: (f32, f32),
+    path: &Path,
+) -> Result<(), String> {
+    let format = image_format(path).ok_or_else(|| {
+        format!(
+            "{}: unknown image format (use .png, .tga, .ppm or .bmp)",
+            path.display()
+        )
+    })?;
+    let bytes = encode_image(frame, view, depth, format)
+        .map_err(|e| format!("{}: cannot encode image: {e}", path.display()))?;
+    write_atomic(path, &bytes).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
+}
+
+/// The image formats tracelab writes, from a file name's extension (any case).
+pub fn image_format(path: &Path) -> Option<image::ImageFormat> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    match ext.as_str() {
+        "png" => Some(image::ImageFormat::Png),
+        "tga" => Some(image::ImageFormat::Tga),
+        "ppm" | "pnm" => Some(image::ImageFormat::Pnm),
+        "bmp" => Some(image::ImageFormat::Bmp),
+        _ => None,
+    }
+}
+
+/// The file's bytes for one view. `.ppm` is binary PPM (`P6`), which the course's tools
+/// read; the `image` crate's default for PNM would be PAM (`P7`).
+pub fn encode_image(
+    frame: &Frame,
+    view: View,
+    depth: (f32, f32),
+    format: image::ImageFormat,
+) -> image::ImageResult<Vec<u8>> {
+    use image::ImageEncoder;
+    use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+
+    let (w, h) = (frame.width, frame.height);
+    if w == 0 || h == 0 {
+        // PNG and BMP encoders would write a header for an image that no reader opens.
+        return Err(image::ImageError::Parameter(
+            image::error::ParameterError::from_kind(
+                image::error::ParameterErrorKind::DimensionMismatch,
+            ),
+        ));
+    }
+    let rgb = frame.rgb8(view, depth);
+    let mut out = Vec::new();
+    let color = image::ExtendedColorType::Rgb8;
+    match format {
+        image::ImageFormat::Pnm => PnmEncoder::new(&mut out)
+            .with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary))
+            .write_image(&rgb, w, h, color)?,
+        image::ImageFormat::Png => {
+            image::codecs::png::PngEncoder::new(&mut out).write_image(&rgb, w, h, color)?
+        }
+        image::ImageFormat::Tga => {
+            image::codecs::tga::TgaEncoder::new(&mut out).write_image(&rgb, w, h, color)?
+        }
+        image::ImageFormat::Bmp => {
+            image::codecs::bmp::BmpEncoder::new(&mut out).write_image(&rgb, w, h, color)?
+        }
+        other => {
+            return Err(image::ImageError::Unsupported(
+                image::error::UnsupportedError::from_format_and_kind(
+                    other.into(),
+                    image::error::UnsupportedErrorKind::Format(other.into()),
+                ),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Follows symlinks from `path` to what they finally name, and what is there (`None` for
+/// nothing yet: a new file, or a link to a file still to be made).
+fn resolve_symlinks(path: &Path) -> io::Result<(PathBuf, Option<Metadata>)> {
+    let mut current = path.to_path_buf();
+    for _ in 0..MAX_SYMLINKS {
+        let meta = match std::fs::symlink_metadata(&current) {
+            Ok(m) => m,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok((current, None)),
+            Err(e) => return Err(e),
+        };
+        if !meta.file_type().is_symlink() {
+            return Ok((current, Some(meta)));
+        }
+        let link = std::fs::read_link(&current)?;
+        // A relative link is relative to the folder holding it.
+        current = match current.parent() {
+            Some(dir) if link.is_relative() => dir.join(link),
+            _ => link,
+        };
+    }
+    Err(io::Error::other(format!(
+        "more than {MAX_SYMLINKS} levels of symbolic links"
+    )))
+}
+
+/// A device node or FIFO: write into it as a shell redirection would.
+fn write_in_place(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
+    file.write_all(bytes)?;
+    file.flush()?;
+    match file.sync_all() {
+        // Character devices and FIFOs have nothing to sync and say so with EINVAL.
+        Err(e)
+            if e.kind() == io::ErrorKind::InvalidInput
+                || e.kind() == io::ErrorKind::Unsupported =>
+        {
+            Ok(())
+        }
+        other => other,
+    }
+}
+
+/// A regular file or a new one: temporary file, sync, rename, sync the folder.
+fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Result<()> {
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tracelab-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // A new file gets the usual 0666 less the umask, not tempfile's private 0600.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.flush()?;
+    if let Some(meta) = existing {
+        keep_mode_and_owner(tmp.as_file(), meta)?;
+    }
+    tmp.as_file().sync_all()?;
+    // On failure the PersistError gives the temporary file back; dropping it removes it.
+    tmp.persist(target).map_err(|e| e.error)?;
+    sync_dir(dir)
+}
+
+/// Gives the new file the mode of the one it replaces and, where allowed, its owner.
+fn keep_mode_and_owner(file: &File, old: &Metadata) -> io::Result<()> {
+    file.set_permissions(old.permissions())?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let new = file.metadata()?;
+        if (new.uid(), new.gid()) != (old.uid(), old.gid()) {
+            match std::os::unix::fs::fchown(file, Some(old.uid()), Some(old.gid())) {
+                Ok(()) => {}
+                // Only root may give a file away; anyone else's new file stays theirs, as an
+                // editor's would. Root must succeed.
+                Err(e) if e.kind() == io::ErrorKind::PermissionDenied && new.uid() != 0 => {}
+                Err(e) => return Err(e),
+            }
+            // chown clears set-user-ID and set-group-ID bits: put the mode back.
+            file.set_permissions(old.permissions())?;
+        }
+    }
+    Ok(())
+}
+
+/// Makes the rename itself durable.
+fn sync_dir(dir: &Path) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        File::open(dir)?.sync_all()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[cfg(unix)]
+    use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("tracelab-io-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("temp dir");
+        d
+    }
+
+    fn names_in(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .expect("read dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// A private device node in `dir` (never the machine's own /dev files); `None`, with a
+    /// message, where mknod is not allowed.
+    #[cfg(unix)]
+    fn mknod(dir: &Path, name: &str, minor: u32) -> Option<PathBuf> {
+        let p = dir.join(name);
+        let ok = std::process::Command::new("mknod")
+            .arg(&p)
+            .args(["c", "1", &minor.to_string()])
+            .status()
+            .is_ok_and(|s| s.success());
+        if !ok {
+            eprintln!("SKIPPED: mknod is not allowed here, cannot make a private device node");
+            return None;
+        }
+        Some(p)
+    }
+
+    #[test]
+    fn writes_a_new_file_and_replaces_an_old_one_leaving_no_temporary_file() {
+        let d = temp_dir("new");
+        let p = d.join("out.txt");
+        write_atomic(&p, b"first").expect("write new");
+        assert_eq!(std::fs::read(&p).expect("read"), b"first");
+        write_atomic(&p, b"second, longer").expect("replace");
+        assert_eq!(std::fs::read(&p).expect("read"), b"second, longer");
+        assert_eq!(names_in(&d), ["out.txt"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn replacing_keeps_the_mode_of_the_old_file() {
+        let d = temp_dir("mode");
+        let p = d.join("secret.txt");
+        std::fs::write(&p, "old").expect("write");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o600)).expect("chmod");
+        write_atomic(&p, b"new").expect("replace");
+        assert_eq!(std::fs::metadata(&p).expect("meta").mode() & 0o7777, 0o600);
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o444)).expect("chmod");
+        write_atomic(&p, b"newer").expect("replace read-only");
+        assert_eq!(std::fs::metadata(&p).expect("meta").mode() & 0o7777, 0o444);
+        assert_eq!(std::fs::read(&p).expect("read"), b"newer");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn replacing_as_root_keeps_the_owner_of_the_old_file() {
+        let d = temp_dir("owner");
+        let p = d.join("theirs.txt");
+        std::fs::write(&p, "old").expect("write");
+        if std::os::unix::fs::chown(&p, Some(65534), Some(65534)).is_err() {
+            eprintln!("SKIPPED: not root, cannot give a file to another user");
+            return;
+        }
+        write_atomic(&p, b"new").expect("replace");
+        let m = std::fs::metadata(&p).expect("meta");
+        assert_eq!((m.uid(), m.gid()), (65534, 65534));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_is_written_through_and_stays_a_link() {
+        let d = temp_dir("link");
+        std::fs::create_dir(d.join("real")).expect("mkdir");
+        std::fs::write(d.join("real/scene.txt"), "old").expect("write");
+        std::os::unix::fs::symlink("real/scene.txt", d.join("link.txt")).expect("symlink");
+        std::os::unix::fs::symlink("link.txt", d.join("link2.txt")).expect("symlink");
+        write_atomic(&d.join("link2.txt"), b"new").expect("write through");
+        assert!(
+            std::fs::symlink_metadata(d.join("link.txt"))
+                .expect("meta")
+                .file_type()
+                .is_symlink()
+        );
+        assert!(
+            std::fs::symlink_metadata(d.join("link2.txt"))
+                .expect("meta")
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(
+            std::fs::read(d.join("real/scene.txt")).expect("read"),
+            b"new"
+        );
+        assert_eq!(names_in(&d.join("real")), ["scene.txt"]);
+        // A dangling link makes its target.
+        std::os::unix::fs::symlink("real/made.txt", d.join("dangling.txt")).expect("symlink");
+        write_atomic(&d.join("dangling.txt"), b"made").expect("write dangling");
+        assert_eq!(
+            std::fs::read(d.join("real/made.txt")).expect("read"),
+            b"made"
+        );
+        // A loop is an error, not a hang.
+        std::os::unix::fs::symlink("loop_b", d.join("loop_a")).expect("symlink");
+        std::os::unix::fs::symlink("loop_a", d.join("loop_b")).expect("symlink");
+        assert!(write_atomic(&d.join("loop_a"), b"x").is_err());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_planted_file_at_a_guessable_temporary_name_is_not_written() {
+        let d = temp_dir("planted");
+        std::fs::write(d.join("victim"), "keep").expect("write");
+        // The old temporary names: `.NAME.tracelab-tmp-PID`.
+        let guess = d.join(format!(".out.txt.tracelab-tmp-{}", std::process::id()));
+        std::os::unix::fs::symlink(d.join("victim"), &guess).expect("plant");
+        write_atomic(&d.join("out.txt"), b"data").expect("write");
+        assert_eq!(std::fs::read(d.join("victim")).expect("read"), b"keep");
+        assert_eq!(std::fs::read(d.join("out.txt")).expect("read"), b"data");
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary_file() {
+        let d = temp_dir("fail");
+        std::fs::write(d.join("old.txt"), "old").expect("write");
+        assert!(write_atomic(&d.join("missing/out.txt"), b"x").is_err());
+        assert!(
+            write_atomic(&d, b"x").is_err(),
+            "a directory is not replaced"
+        );
+        assert!(d.is_dir());
+        assert_eq!(names_in(&d), ["old.txt"]);
+        assert_eq!(std::fs::read(d.join("old.txt")).expect("read"), b"old");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_full_device_is_written_into_reports_its_error_and_stays_a_device() {
+        let d = temp_dir("full");
+        let Some(full) = mknod(&d, "full", 7) else {
+            return;
+        };
+        let e = write_atomic(&full, b"bytes").expect_err("a full device fails");
+        assert_eq!(e.kind(), io::ErrorKind::StorageFull, "{e}");
+        assert!(
+            std::fs::symlink_metadata(&full)
+                .expect("meta")
+                .file_type()
+                .is_char_device()
+        );
+        let Some(null) = mknod(&d, "null", 3) else {
+            return;
+        };
+        write_atomic(&null, b"bytes").expect("a null device takes anything");
+        assert!(
+            std::fs::symlink_metadata(&null)
+                .expect("meta")
+                .file_type()
+                .is_char_device()
+        );
+        assert_eq!(names_in(&d), ["full", "null"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_written_into_and_stays_a_fifo() {
+        let d = temp_dir("fifo");
+        let fifo = d.join("pipe");
+        let ok = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(ok, "mkfifo");
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).expect("read fifo"))
+        };
+        write_atomic(&fifo, b"through the pipe").expect("write fifo");
+        assert_eq!(reader.join().expect("reader"), b"through the pipe");
+        assert!(
+            std::fs::symlink_metadata(&fifo)
+                .expect("meta")
+                .file_type()
+                .is_fifo()
+        );
+    }
+
+    #[test]
+    fn ppm_is_binary_p6() {
+        let frame = Frame::new(3, 2);
+        let bytes =
+            encode_image(&frame, View::Color, (0.0, 1.0), image::ImageFormat::Pnm).expect("encode");
+        assert!(
+            bytes.starts_with(b"P6\n3 2 255\n"),
+            "{:?}",
+            String::from_utf8_lossy(&bytes[..12])
+        );
+        assert_eq!(bytes.len(), b"P6\n3 2 255\n".len() + 3 * 2 * 3);
+    }
+
+    #[test]
+    fn a_failed_encode_never_touches_the_existing_file() {
+        let d = temp_dir("encode");
+        let p = d.join("wide.tga");
+        std::fs::write(&p, "old image").expect("write");
+        // TGA stores sides in 16 bits.
+        let wide = Frame::new(70_000, 1);
+        let e = write_image(&wide, View::Color, (0.0, 1.0), &p).expect_err("too wide for TGA");
+        assert!(e.contains("cannot encode image"), "{e}");
+        let empty = Frame::new(0, 0);
+        for name in ["wide.tga", "e.png", "e.bmp", "e.ppm"] {
+            assert!(
+                write_image(&empty, View::Color, (0.0, 1.0), &d.join(name)).is_err(),
+                "{name}"
+            );
+        }
+        assert_eq!(std::fs::read(&p).expect("read"), b"old image");
+        assert_eq!(names_in(&d), ["wide.tga"]);
+    }
+}
