@@ -1,6 +1,7 @@
 //! Errors and warnings with locations. Spans are byte offsets; line and column (1-based,
 //! columns counted in characters) are computed once, for display.
 
+use std::cell::Cell;
 use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,22 +69,33 @@ pub struct SourceFile<'a> {
     pub name: &'a str,
     pub text: &'a str,
     line_starts: Vec<usize>,
+    /// The last offset looked up, as (line index, offset, column): the parser reports in
+    /// file order, so counting characters on from there keeps many errors on one long line
+    /// linear instead of quadratic.
+    cursor: Cell<(usize, usize, u32)>,
 }
 
 impl<'a> SourceFile<'a> {
     pub fn new(name: &'a str, text: &'a str) -> Self {
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        SourceFile { name, text, line_starts }
+        SourceFile { name, text, line_starts, cursor: Cell::new((0, 0, 0)) }
     }
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (u32, u32) {
         let offset = offset.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= offset).saturating_sub(1);
-        let start = self.line_starts[line];
-        let col = self.text.get(start..offset).map_or(offset - start, |s| s.chars().count());
-        (line as u32 + 1, col as u32 + 1)
+        let (c_line, c_off, c_col) = self.cursor.get();
+        let (from, base) = if c_line == line && c_off <= offset {
+            (c_off, c_col)
+        } else {
+            (self.line_starts.get(line).copied().unwrap_or(0), 0)
+        };
+        let counted = self.text.get(from..offset).map_or(offset - from, |s| s.chars().count());
+        let col = base.saturating_add(u32::try_from(counted).unwrap_or(u32::MAX));
+        self.cursor.set((line, offset, col));
+        (u32::try_from(line + 1).unwrap_or(u32::MAX), col.saturating_add(1))
     }
 
     pub fn diagnostic(&self, severity: Severity, offset: usize, message: impl Into<String>) -> Diagnostic {
@@ -103,5 +115,30 @@ mod tests {
         assert_eq!(s.line_col(3), (2, 1));
         // 'ç' is two bytes but one column.
         assert_eq!(s.line_col(7), (2, 4));
+    }
+
+    #[test]
+    fn lookups_in_any_order_agree_with_counting_from_the_line_start() {
+        let text = "aé b\nçç ç\n\nxyz";
+        let s = SourceFile::new("f", text);
+        let offsets: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        let expected: Vec<(u32, u32)> = offsets
+            .iter()
+            .map(|&o| {
+                let before = &text[..o];
+                let line = before.matches('\n').count() as u32 + 1;
+                let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) as u32 + 1;
+                (line, col)
+            })
+            .collect();
+        // Forwards (the cursor is reused), backwards, and jumping about.
+        let forwards: Vec<_> = offsets.iter().map(|&o| s.line_col(o)).collect();
+        assert_eq!(forwards, expected);
+        for (k, &o) in offsets.iter().enumerate().rev() {
+            assert_eq!(s.line_col(o), expected[k]);
+        }
+        for k in [5, 1, 9, 2, 2, 13, 0] {
+            assert_eq!(s.line_col(offsets[k]), expected[k]);
+        }
     }
 }

@@ -5,8 +5,9 @@ mod diagnostic;
 mod lexer;
 pub mod obj;
 mod parser;
+mod token_stream;
 mod writer;
 
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
-pub use parser::{ParseOutcome, load_scene, parse_scene};
+pub use parser::{MAX_SCENE_BYTES, ParseOutcome, load_scene, parse_scene};
 pub use writer::{uses_only_course_grammar, write_scene};

@@ -9,8 +9,9 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
-use super::lexer::{TokKind, Token, tokenize};
+use super::lexer::{TokKind, Token};
 use super::obj::{MeshCache, resolve_obj_path};
+use super::token_stream::TokenStream;
 use crate::scene::{
     Background, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node, NodeId,
     NodeKind, Scene, TransformOp, check_closed, compose,
@@ -35,22 +36,33 @@ impl ParseOutcome {
     }
 }
 
+/// The largest scene file read. Scenes are hand-written or generated text (meshes live in OBJ
+/// files); the cap keeps a device, a FIFO or a mistaken huge file from filling memory.
+pub const MAX_SCENE_BYTES: usize = 64 << 20;
+
 /// Reads and parses a scene file; OBJ paths resolve against the file's folder first.
 pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
     let name = path.display().to_string();
-    match std::fs::read(path) {
-        Ok(bytes) => parse_scene(&bytes, &name, path.parent(), cache),
-        Err(e) => ParseOutcome {
-            scene: None,
-            diagnostics: Diagnostics(vec![Diagnostic {
-                severity: Severity::Error,
-                file: name,
-                line: 0,
-                col: 0,
-                message: format!("cannot read scene file: {e}"),
-            }]),
-        },
+    let whole_file_error = |message: String| ParseOutcome {
+        scene: None,
+        diagnostics: Diagnostics(vec![Diagnostic { severity: Severity::Error, file: name.clone(), line: 0, col: 0, message }]),
+    };
+    match read_capped(path, MAX_SCENE_BYTES) {
+        Ok(Some(bytes)) => parse_scene(&bytes, &name, path.parent(), cache),
+        Ok(None) => whole_file_error(format!("the file is larger than {} MiB, the most tracelab reads as a scene", MAX_SCENE_BYTES >> 20)),
+        Err(e) => whole_file_error(format!("cannot read scene file: {e}")),
     }
+}
+
+/// The file's bytes, or None when it holds more than `cap`. Reads at most `cap + 1` bytes, so
+/// a character device or a FIFO that never ends cannot be read forever.
+pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec<u8>>> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path)?;
+    let hint = file.metadata().map_or(0, |m| m.len()).min(cap as u64 + 1) as usize;
+    let mut bytes = Vec::with_capacity(hint);
+    file.take(cap as u64 + 1).read_to_end(&mut bytes)?;
+    Ok((bytes.len() <= cap).then_some(bytes))
 }
 
 /// Parses scene text. `name` is used in messages; `base_dir` is where OBJ files are looked
@@ -78,9 +90,10 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
     };
     let mut p = Parser {
         src: SourceFile::new(name, text),
-        toks: tokenize(text),
+        toks: TokenStream::new(text),
         pos: 0,
         diags: Vec::new(),
+        unshown: Unshown::default(),
         fatal: false,
         base_dir,
         cache,
@@ -102,9 +115,10 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
 
 struct Parser<'a> {
     src: SourceFile<'a>,
-    toks: Vec<Token>,
+    toks: TokenStream<'a>,
     pos: usize,
     diags: Vec<Diagnostic>,
+    unshown: Unshown,
     /// Set by any error that leaves the scene incomplete.
     fatal: bool,
     base_dir: Option<&'a Path>,
@@ -126,6 +140,20 @@ struct Parser<'a> {
     /// Closedness already checked, per mesh (by address), so a mesh used many times is
     /// checked once.
     closed_meshes: HashMap<usize, Result<(), String>>,
+}
+
+/// Errors (and, separately, warnings) past this many are counted, not shown: a file of a
+/// million stray braces must not print a million lines.
+const MAX_SHOWN: usize = 20;
+
+/// Diagnostics beyond the first `MAX_SHOWN` of their severity: how many, and where the first
+/// of them is.
+#[derive(Default)]
+struct Unshown {
+    shown_errors: usize,
+    shown_warnings: usize,
+    errors: (usize, usize),
+    warnings: (usize, usize),
 }
 
 /// One `name value…` line inside a flat block.
@@ -193,7 +221,7 @@ impl<'a> Parser<'a> {
     // ---------------------------------------------------------------- tokens and messages
 
     fn peek(&self) -> Option<Token> {
-        self.toks.get(self.pos).copied()
+        self.toks.get(self.pos)
     }
 
     fn next(&mut self) -> Option<Token> {
@@ -219,18 +247,45 @@ impl<'a> Parser<'a> {
 
     fn error(&mut self, offset: usize, msg: impl Into<String>) {
         self.fatal = true;
-        let d = self.src.diagnostic(Severity::Error, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Error, offset, msg);
     }
 
     fn node_error(&mut self, offset: usize, msg: impl Into<String>) {
-        let d = self.src.diagnostic(Severity::Error, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Error, offset, msg);
     }
 
     fn warn(&mut self, offset: usize, msg: impl Into<String>) {
-        let d = self.src.diagnostic(Severity::Warning, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Warning, offset, msg);
+    }
+
+    fn report(&mut self, severity: Severity, offset: usize, msg: impl Into<String>) {
+        let u = &mut self.unshown;
+        let (shown, unshown) = match severity {
+            Severity::Error => (&mut u.shown_errors, &mut u.errors),
+            Severity::Warning => (&mut u.shown_warnings, &mut u.warnings),
+        };
+        if *shown < MAX_SHOWN {
+            *shown += 1;
+            let d = self.src.diagnostic(severity, offset, msg);
+            self.diags.push(d);
+        } else {
+            if unshown.0 == 0 {
+                unshown.1 = offset;
+            }
+            unshown.0 += 1;
+        }
+    }
+
+    /// "… and N more", located at the first diagnostic left out.
+    fn summarise_unshown(&mut self) {
+        let u = &self.unshown;
+        for (severity, (n, at), what) in [(Severity::Error, u.errors, "error"), (Severity::Warning, u.warnings, "warning")] {
+            if n > 0 {
+                let s = if n == 1 { "" } else { "s" };
+                let d = self.src.diagnostic(severity, at, format!("… and {n} more {what}{s}"));
+                self.diags.push(d);
+            }
+        }
     }
 
     /// Skips to just past the `}` that closes a block whose `{` was already read.
@@ -1108,6 +1163,7 @@ impl<'a> Parser<'a> {
                 self.warn(*at, "no MaterialIndex applies to this object; it uses the default grey material");
             }
         }
+        self.summarise_unshown();
         let scene = if self.fatal {
             None
         } else {

@@ -1,0 +1,101 @@
+//! Scene input built to hurt: endless or huge files, very long lines, floods of errors,
+//! control bytes and numbers that do not fit. Each must give a short, located answer quickly
+//! and with bounded memory.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use tracelab_core::{MeshCache, ParseOutcome, load_scene, parse_scene};
+
+/// The most a scene file may hold (as the message says).
+const MAX_SCENE_BYTES: usize = 64 << 20;
+
+fn parse(text: &str) -> ParseOutcome {
+    parse_scene(text.as_bytes(), "scene.txt", None, &mut MeshCache::new())
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tracelab-hostile-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+const HEAD: &str = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
+Materials { numMaterials 1 Material { diffuseColor 1 0 0 } }\n";
+
+#[test]
+fn an_endless_character_device_is_cut_off_at_the_size_cap() {
+    // Reading /dev/zero is harmless; only writing to device files is not.
+    let start = Instant::now();
+    let out = load_scene(Path::new("/dev/zero"), &mut MeshCache::new());
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 1, "{}", out.diagnostics);
+    assert!(e[0].message.contains("larger than 64 MiB"), "{}", e[0]);
+    assert!(out.scene.is_none());
+    assert!(start.elapsed() < Duration::from_secs(20));
+}
+
+#[test]
+fn a_file_over_the_cap_is_refused_and_one_at_the_cap_is_read() {
+    let dir = temp_dir("cap");
+    let big = dir.join("big.txt");
+    // Sparse: no disk is spent on the zeros.
+    let f = std::fs::File::create(&big).expect("create");
+    f.set_len(MAX_SCENE_BYTES as u64 + 1).expect("set_len");
+    let out = load_scene(&big, &mut MeshCache::new());
+    let d = out.diagnostics.errors().next().expect("an error");
+    assert_eq!(
+        d.to_string(),
+        format!("{}: the file is larger than 64 MiB, the most tracelab reads as a scene", big.display())
+    );
+    // At the cap the text is read (and then found to be NULs, not text).
+    f.set_len(MAX_SCENE_BYTES as u64).expect("set_len");
+    let out = load_scene(&big, &mut MeshCache::new());
+    let d = out.diagnostics.errors().next().expect("an error");
+    assert!(d.message.contains("NUL"), "{d}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_flood_of_errors_stops_at_twenty_with_a_count_of_the_rest() {
+    let text = format!("{HEAD}{}", "} ".repeat(1000));
+    let out = parse(&text);
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 21, "{}", out.diagnostics);
+    assert!(e[..20].iter().all(|d| d.message == "unexpected \"}\" outside any block"));
+    // The summary is located at the first error not shown, and still an error.
+    assert_eq!(e[20].message, "… and 981 more errors");
+    assert_eq!((e[20].line, e[20].col), (3, 41));
+}
+
+#[test]
+fn errors_on_one_long_line_are_located_in_linear_time() {
+    // 1 MB on one line; multi-byte characters make every column a count of characters.
+    let line = "é} ".repeat(250_000);
+    let text = format!("{HEAD}{line}\nGroup {{ numObjects 0 }}\n");
+    let start = Instant::now();
+    let out = parse(&text);
+    let took = start.elapsed();
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 21);
+    assert_eq!((e[0].line, e[0].col), (3, 1));
+    assert_eq!(
+        e[0].message,
+        "unknown keyword \"é\" (expected OrthographicCamera, PerspectiveCamera, Lights, Background, Materials or Group)"
+    );
+    assert_eq!((e[1].line, e[1].col), (3, 2));
+    assert_eq!((e[19].line, e[19].col), (3, 29));
+    // Quadratic lookups took 16 s for this; linear ones take milliseconds.
+    assert!(took < Duration::from_secs(2), "took {took:?}");
+}
+
+#[test]
+fn twenty_megabytes_of_closing_braces_give_a_short_answer() {
+    let text = "}".repeat(20 << 20);
+    let start = Instant::now();
+    let out = parse(&text);
+    let shown = out.diagnostics.to_string();
+    assert!(shown.len() < 4096, "{} bytes of messages", shown.len());
+    assert!(shown.contains(&format!("… and {} more errors", (20 << 20) - 20 + 2)), "{shown}");
+    assert!(start.elapsed() < Duration::from_secs(10));
+}
