@@ -99,3 +99,51 @@ fn twenty_megabytes_of_closing_braces_give_a_short_answer() {
     assert!(shown.contains(&format!("… and {} more errors", (20 << 20) - 20 + 2)), "{shown}");
     assert!(start.elapsed() < Duration::from_secs(10));
 }
+
+fn errors(text: &str) -> Vec<String> {
+    parse(text).diagnostics.errors().map(|d| format!("{}:{}: {}", d.line, d.col, d.message)).collect()
+}
+
+#[test]
+fn control_bytes_from_the_input_are_escaped_in_messages() {
+    let out = parse(&format!("{HEAD}\u{1b}[2J\u{1b}]0;pwned\u{7}\nGroup {{ numObjects 0 Sph\u{b}ere {{ }} }}\n"));
+    let shown = out.diagnostics.to_string();
+    assert!(!shown.chars().any(|c| c.is_control() && c != '\n'), "{shown:?}");
+    let e: Vec<_> = out.diagnostics.errors().map(|d| d.message.clone()).collect();
+    assert!(e[0].starts_with("unknown keyword \"\\x1b[2J\\x1b]0;pwned\\x07\""), "{e:?}");
+    assert!(e[1].starts_with("unknown keyword \"Sph\\x0bere\" in Group"), "{e:?}");
+}
+
+#[test]
+fn numbers_are_quoted_as_written() {
+    let group = |inner: &str| format!("{HEAD}Group {{ numObjects 1 {inner} }}\n");
+    let e = errors(&group("MaterialIndex 4294967296 Sphere { center 0 0 0 radius 1 }"));
+    assert_eq!(e, ["3:36: MaterialIndex 4294967296 is out of range: valid indices are 0 to 0"]);
+    let e = errors(&group("MaterialIndex 0 Sphere { center 0 0 0 radius 1 1e-60 }"));
+    assert_eq!(e, ["3:69: \"radius\" takes 1 number(s); found an extra \"1e-60\""]);
+}
+
+#[test]
+fn a_field_given_twice_in_a_material_is_an_error() {
+    let e = errors(&format!(
+        "{}Materials {{ numMaterials 1 Material {{ diffuseColor 1 0 0 diffuseColor 0 1 0 }} }}\nGroup {{ numObjects 0 }}\n",
+        &HEAD[..HEAD.find("Materials").unwrap_or(0)]
+    ));
+    assert_eq!(e, ["2:58: \"diffuseColor\" is given twice in Material"]);
+    // Fields tracelab keeps but does not shade with count too.
+    let e = errors(&format!(
+        "{}Materials {{ numMaterials 1 PhongMaterial {{ diffuseColor 1 0 0 exponent 2 exponent 3 }} }}\nGroup {{ numObjects 0 }}\n",
+        &HEAD[..HEAD.find("Materials").unwrap_or(0)]
+    ));
+    assert_eq!(e, ["2:74: \"exponent\" is given twice in PhongMaterial"]);
+}
+
+#[test]
+fn a_material_does_not_take_a_file_name() {
+    // It used to be kept without its name and written back as a bare "obj_file".
+    let e = errors(&format!(
+        "{}Materials {{ numMaterials 1 Material {{ diffuseColor 1 0 0 obj_file a.obj }} }}\nGroup {{ numObjects 0 }}\n",
+        &HEAD[..HEAD.find("Materials").unwrap_or(0)]
+    ));
+    assert_eq!(e, ["2:58: \"obj_file\" belongs in TriangleMesh, not in Material (material fields take numbers)"]);
+}

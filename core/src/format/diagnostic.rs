@@ -1,6 +1,7 @@
 //! Errors and warnings with locations. Spans are byte offsets; line and column (1-based,
 //! columns counted in characters) are computed once, for display.
 
+use std::borrow::Cow;
 use std::cell::Cell;
 use std::fmt;
 
@@ -20,16 +21,36 @@ pub struct Diagnostic {
     pub message: String,
 }
 
+/// Text from a file or a path made safe to print: control characters (ESC, vertical tab, …)
+/// and bidirectional overrides are written as escapes, so a message cannot drive the terminal
+/// or reorder what it shows.
+pub fn escape_controls(s: &str) -> Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(unsafe_char) {
+        return Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 8);
+    for c in s.chars() {
+        match c {
+            _ if !unsafe_char(c) => out.push(c),
+            _ if (c as u32) < 0x80 => out.push_str(&format!("\\x{:02x}", c as u32)),
+            _ => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+        }
+    }
+    Cow::Owned(out)
+}
+
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let sev = match self.severity {
             Severity::Error => "",
             Severity::Warning => "warning: ",
         };
+        let (file, message) = (escape_controls(&self.file), escape_controls(&self.message));
         if self.line == 0 {
-            write!(f, "{}: {sev}{}", self.file, self.message)
+            write!(f, "{file}: {sev}{message}")
         } else {
-            write!(f, "{}:{}:{}: {sev}{}", self.file, self.line, self.col, self.message)
+            write!(f, "{file}:{}:{}: {sev}{message}", self.line, self.col)
         }
     }
 }
@@ -100,7 +121,12 @@ impl<'a> SourceFile<'a> {
 
     pub fn diagnostic(&self, severity: Severity, offset: usize, message: impl Into<String>) -> Diagnostic {
         let (line, col) = self.line_col(offset);
-        Diagnostic { severity, file: self.name.to_string(), line, col, message: message.into() }
+        let message = message.into();
+        let message = match escape_controls(&message) {
+            Cow::Borrowed(_) => message,
+            Cow::Owned(escaped) => escaped,
+        };
+        Diagnostic { severity, file: self.name.to_string(), line, col, message }
     }
 }
 
@@ -115,6 +141,15 @@ mod tests {
         assert_eq!(s.line_col(3), (2, 1));
         // 'ç' is two bytes but one column.
         assert_eq!(s.line_col(7), (2, 4));
+    }
+
+    #[test]
+    fn control_characters_are_escaped_and_other_text_kept() {
+        assert_eq!(escape_controls("plain é ✓"), "plain é ✓");
+        assert_eq!(escape_controls("a\u{1b}[31mb\u{b}c\u{7f}\u{202e}d\u{85}"), "a\\x1b[31mb\\x0bc\\x7f\\u{202e}d\\u{85}");
+        // Escaping twice changes nothing more.
+        let once = escape_controls("\u{1b}x").into_owned();
+        assert_eq!(escape_controls(&once), once);
     }
 
     #[test]

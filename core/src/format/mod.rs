@@ -8,6 +8,6 @@ mod parser;
 mod token_stream;
 mod writer;
 
-pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
+pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile, escape_controls};
 pub use parser::{MAX_SCENE_BYTES, ParseOutcome, load_scene, parse_scene};
 pub use writer::{uses_only_course_grammar, write_scene};

@@ -237,6 +237,14 @@ impl<'a> Parser<'a> {
         &text[t.start..t.end]
     }
 
+    /// The word that starts at `offset`, as written (for quoting numbers in messages).
+    fn word_at(&self, offset: usize) -> &'a str {
+        let text: &'a str = self.src.text;
+        let rest = text.get(offset..).unwrap_or("");
+        let end = rest.find(|c: char| c.is_ascii_whitespace() || matches!(c, '{' | '}' | '#')).unwrap_or(rest.len());
+        &rest[..end]
+    }
+
     /// How a token reads in a "found …" message.
     fn describe(&self, t: Option<Token>) -> (String, usize) {
         match t {
@@ -474,7 +482,8 @@ impl<'a> Parser<'a> {
             return None;
         }
         if f.values.len() > n {
-            let (extra, off) = (f.values[n].0, f.values[n].1);
+            let off = f.values[n].1;
+            let extra = self.word_at(off);
             self.error(off, format!("\"{name}\" takes {n} number(s); found an extra \"{extra}\""));
             return None;
         }
@@ -656,6 +665,21 @@ impl<'a> Parser<'a> {
         let open = self.expect_open(kw)?;
         let mut f = self.read_fields(kw, open)?;
         let diffuse = self.take_vec3(&mut f, kw, off, "diffuseColor")?;
+        let mut ok = true;
+        for (i, x) in f.iter().enumerate() {
+            let msg = if x.word.is_some() {
+                format!("\"{}\" belongs in TriangleMesh, not in {kw} (material fields take numbers)", x.name)
+            } else if f[..i].iter().any(|y| y.name == x.name) {
+                format!("\"{}\" is given twice in {kw}", x.name)
+            } else {
+                continue;
+            };
+            self.error(x.name_off, msg);
+            ok = false;
+        }
+        if !ok {
+            return None;
+        }
         let keyword = if kw == "PhongMaterial" { MaterialKeyword::PhongMaterial } else { MaterialKeyword::Material };
         // Other fields (specularColor, exponent, …) are kept, not shaded with.
         let extra = f
@@ -1138,7 +1162,8 @@ impl<'a> Parser<'a> {
         for (i, at) in std::mem::take(&mut self.material_refs) {
             if i as usize >= n {
                 let range = if n == 0 { "the scene has no materials".to_string() } else { format!("valid indices are 0 to {}", n - 1) };
-                self.error(at, format!("MaterialIndex {i} is out of range: {range}"));
+                let written = self.word_at(at);
+                self.error(at, format!("MaterialIndex {written} is out of range: {range}"));
             }
         }
         if self.camera.is_none() && !self.camera_seen {
