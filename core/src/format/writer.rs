@@ -17,8 +17,9 @@ fn indent(depth: usize) -> String {
 }
 
 fn num(x: f32) -> String {
-    // `{}` on f32 prints the shortest text that parses back to the same value. Avoid "-0".
-    if x == 0.0 { "0".to_string() } else { format!("{x}") }
+    // `{}` on f32 prints the shortest text that parses back to the same value, "-0" included:
+    // the sign of a zero changes renders (1/-0 is -inf in a ray's slab test).
+    format!("{x}")
 }
 
 fn v3(v: Vec3) -> String {
