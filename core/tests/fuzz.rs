@@ -162,6 +162,18 @@ const SCENE_WORDS: &[&str] = &[
     "no_such.obj",
     ".",
     "/dev/null",
+    // Whole fields, so that an insertion can make a block that is still accepted.
+    "obj_file cube.obj",
+    "obj_file ../assets/cube.obj",
+    "diffuseColor 1 0 0",
+    "specularColor 1 1 1",
+    "exponent 7",
+    "MaterialIndex 0",
+    "radius 2",
+    "Scale 1 2 3",
+    "UniformScale -1",
+    "ZRotate -0",
+    "Rotate { 0 1 0 30 }",
 ];
 
 /// One scene case: the properties the harness holds the parser, writer and renderer to.
