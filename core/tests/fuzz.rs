@@ -12,11 +12,15 @@ mod common;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 use common::{Rng, fuzz_cases, mutate_text, quoted};
 use tracelab_core::format::obj::{load_with_tobj, parse_obj, parse_obj_fast};
 use tracelab_core::{Frame, MeshCache, RenderSettings, Scene, compile, parse_scene, render_frame, write_scene};
+
+/// One case taking longer than this is a hang (cases take well under a millisecond).
+const CASE_LIMIT_MS: u64 = 20_000;
 
 const SCENE_SEED: u64 = 0x5eed_0f_5ce_9e5;
 const OBJ_SEED: u64 = 0x0b1_5eed_f00d;
@@ -67,16 +71,39 @@ fn run_cases(name: &str, n: u64, case: impl Fn(u64, &mut MeshCache) -> Result<()
     let only: Option<u64> = std::env::var("TRACELAB_FUZZ_CASE").ok().and_then(|v| v.parse().ok());
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
     let start = Instant::now();
+    // Per thread: the case running and when it started (ms since `start`), for the watchdog.
+    let running: Vec<(AtomicU64, AtomicU64)> = (0..threads).map(|_| (AtomicU64::new(0), AtomicU64::new(0))).collect();
+    let done = AtomicBool::new(false);
     let failures: Vec<String> = std::thread::scope(|s| {
+        // A hang cannot be caught: name the case, then end the run.
+        s.spawn(|| {
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(std::time::Duration::from_millis(200));
+                let now = start.elapsed().as_millis() as u64;
+                for (k, since) in &running {
+                    let (k, since) = (k.load(Ordering::Relaxed), since.load(Ordering::Relaxed));
+                    if now.saturating_sub(since) > CASE_LIMIT_MS && !done.load(Ordering::Relaxed) {
+                        skip_note(&format!(
+                            "{name}: case {k} has run for over {} s: a hang; replay it with TRACELAB_FUZZ_CASE={k}",
+                            CASE_LIMIT_MS / 1000
+                        ));
+                        std::process::exit(1);
+                    }
+                }
+            }
+        });
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 let case = &case;
+                let running = &running;
                 s.spawn(move || {
                     let mut cache = MeshCache::new();
                     let mut failures = Vec::new();
                     let mut k = t;
                     while k < n && failures.len() < 3 {
                         if only.is_none_or(|o| o == k) {
+                            running[t as usize].0.store(k, Ordering::Relaxed);
+                            running[t as usize].1.store(start.elapsed().as_millis() as u64, Ordering::Relaxed);
                             match catch_unwind(AssertUnwindSafe(|| case(k, &mut cache))) {
                                 Ok(Ok(())) => {}
                                 Ok(Err(why)) => failures.push(format!("case {k}: {why}")),
@@ -92,7 +119,10 @@ fn run_cases(name: &str, n: u64, case: impl Fn(u64, &mut MeshCache) -> Result<()
                 })
             })
             .collect();
-        handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|_| vec!["a worker died".to_string()])).collect()
+        let failures =
+            handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|_| vec!["a worker died".to_string()])).collect();
+        done.store(true, Ordering::Relaxed);
+        failures
     });
     skip_note(&format!("{name}: {n} cases in {:.1} s on {threads} threads", start.elapsed().as_secs_f64()));
     assert!(
@@ -228,6 +258,9 @@ fn mutated_scenes_never_panic_and_accepted_ones_round_trip() {
         let mut rng = Rng::for_case(SCENE_SEED, k);
         let (path, seed) = &seeds[rng.below(seeds.len())];
         let input = mutate_text(seed, SCENE_WORDS, &mut rng);
+        if std::env::var("TRACELAB_FUZZ_CASE").is_ok() {
+            skip_note(&format!("case {k}: seed {}\ninput {}", path.display(), quoted(&input)));
+        }
         let dir = path.parent().unwrap_or(Path::new("."));
         let r = scene_case(&input, dir, cache);
         if r.is_ok() && parse_scene(&input, "fuzz.txt", Some(dir), cache).into_result().is_ok() {
