@@ -1,6 +1,8 @@
 //! Errors and warnings with locations. Spans are byte offsets; line and column (1-based,
 //! columns counted in characters) are computed once, for display.
 
+use std::borrow::Cow;
+use std::cell::Cell;
 use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,16 +21,36 @@ pub struct Diagnostic {
     pub message: String,
 }
 
+/// Text from a file or a path made safe to print: control characters (ESC, vertical tab, …)
+/// and bidirectional overrides are written as escapes, so a message cannot drive the terminal
+/// or reorder what it shows.
+pub fn escape_controls(s: &str) -> Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(unsafe_char) {
+        return Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 8);
+    for c in s.chars() {
+        match c {
+            _ if !unsafe_char(c) => out.push(c),
+            _ if (c as u32) < 0x80 => out.push_str(&format!("\\x{:02x}", c as u32)),
+            _ => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+        }
+    }
+    Cow::Owned(out)
+}
+
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let sev = match self.severity {
             Severity::Error => "",
             Severity::Warning => "warning: ",
         };
+        let (file, message) = (escape_controls(&self.file), escape_controls(&self.message));
         if self.line == 0 {
-            write!(f, "{}: {sev}{}", self.file, self.message)
+            write!(f, "{file}: {sev}{message}")
         } else {
-            write!(f, "{}:{}:{}: {sev}{}", self.file, self.line, self.col, self.message)
+            write!(f, "{file}:{}:{}: {sev}{message}", self.line, self.col)
         }
     }
 }
@@ -68,27 +90,43 @@ pub struct SourceFile<'a> {
     pub name: &'a str,
     pub text: &'a str,
     line_starts: Vec<usize>,
+    /// The last offset looked up, as (line index, offset, column): the parser reports in
+    /// file order, so counting characters on from there keeps many errors on one long line
+    /// linear instead of quadratic.
+    cursor: Cell<(usize, usize, u32)>,
 }
 
 impl<'a> SourceFile<'a> {
     pub fn new(name: &'a str, text: &'a str) -> Self {
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        SourceFile { name, text, line_starts }
+        SourceFile { name, text, line_starts, cursor: Cell::new((0, 0, 0)) }
     }
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (u32, u32) {
         let offset = offset.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= offset).saturating_sub(1);
-        let start = self.line_starts[line];
-        let col = self.text.get(start..offset).map_or(offset - start, |s| s.chars().count());
-        (line as u32 + 1, col as u32 + 1)
+        let (c_line, c_off, c_col) = self.cursor.get();
+        let (from, base) = if c_line == line && c_off <= offset {
+            (c_off, c_col)
+        } else {
+            (self.line_starts.get(line).copied().unwrap_or(0), 0)
+        };
+        let counted = self.text.get(from..offset).map_or(offset - from, |s| s.chars().count());
+        let col = base.saturating_add(u32::try_from(counted).unwrap_or(u32::MAX));
+        self.cursor.set((line, offset, col));
+        (u32::try_from(line + 1).unwrap_or(u32::MAX), col.saturating_add(1))
     }
 
     pub fn diagnostic(&self, severity: Severity, offset: usize, message: impl Into<String>) -> Diagnostic {
         let (line, col) = self.line_col(offset);
-        Diagnostic { severity, file: self.name.to_string(), line, col, message: message.into() }
+        let message = message.into();
+        let message = match escape_controls(&message) {
+            Cow::Borrowed(_) => message,
+            Cow::Owned(escaped) => escaped,
+        };
+        Diagnostic { severity, file: self.name.to_string(), line, col, message }
     }
 }
 
@@ -103,5 +141,39 @@ mod tests {
         assert_eq!(s.line_col(3), (2, 1));
         // 'ç' is two bytes but one column.
         assert_eq!(s.line_col(7), (2, 4));
+    }
+
+    #[test]
+    fn control_characters_are_escaped_and_other_text_kept() {
+        assert_eq!(escape_controls("plain é ✓"), "plain é ✓");
+        assert_eq!(escape_controls("a\u{1b}[31mb\u{b}c\u{7f}\u{202e}d\u{85}"), "a\\x1b[31mb\\x0bc\\x7f\\u{202e}d\\u{85}");
+        // Escaping twice changes nothing more.
+        let once = escape_controls("\u{1b}x").into_owned();
+        assert_eq!(escape_controls(&once), once);
+    }
+
+    #[test]
+    fn lookups_in_any_order_agree_with_counting_from_the_line_start() {
+        let text = "aé b\nçç ç\n\nxyz";
+        let s = SourceFile::new("f", text);
+        let offsets: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        let expected: Vec<(u32, u32)> = offsets
+            .iter()
+            .map(|&o| {
+                let before = &text[..o];
+                let line = before.matches('\n').count() as u32 + 1;
+                let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) as u32 + 1;
+                (line, col)
+            })
+            .collect();
+        // Forwards (the cursor is reused), backwards, and jumping about.
+        let forwards: Vec<_> = offsets.iter().map(|&o| s.line_col(o)).collect();
+        assert_eq!(forwards, expected);
+        for (k, &o) in offsets.iter().enumerate().rev() {
+            assert_eq!(s.line_col(o), expected[k]);
+        }
+        for k in [5, 1, 9, 2, 2, 13, 0] {
+            assert_eq!(s.line_col(offsets[k]), expected[k]);
+        }
     }
 }

@@ -8,7 +8,7 @@ mod parser;
 mod rebase;
 mod writer;
 
-pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
-pub use parser::{ParseOutcome, load_scene, parse_scene};
+pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile, escape_controls};
+pub use parser::{MAX_SCENE_BYTES, ParseOutcome, load_scene, parse_scene};
 pub use rebase::rebase_mesh_paths;
 pub use writer::{uses_only_course_grammar, write_scene};

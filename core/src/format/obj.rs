@@ -3,6 +3,7 @@
 //! reader; anything it does not understand goes to `tobj`, the reference.
 
 mod fast;
+mod file_kind;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -12,8 +13,15 @@ use std::time::SystemTime;
 use glam::Vec3;
 
 use crate::scene::Mesh;
+use file_kind::{FileKind, file_kind, open_regular};
 
-/// Resolves `obj_file` against the scene's folder first, then the current folder.
+/// The largest OBJ file read: 15 times the 871k-triangle dragon. Bigger files would need
+/// several times their size in memory for parsing and the BVH.
+pub const MAX_OBJ_BYTES: usize = 512 << 20;
+
+/// Resolves `obj_file` against the scene's folder first, then the current folder. The first
+/// candidate that exists decides: a folder, FIFO, device or symlink loop there is reported
+/// as what it is, not skipped as "not found".
 ///
 /// The current-folder fallback stays for the course's command lines, which open OBJ files
 /// relative to the working directory (`raytracer -input ../scenes/x.txt` run from the folder
@@ -22,26 +30,21 @@ use crate::scene::Mesh;
 /// ([`crate::format::rebase_mesh_paths`]), and the parser warns whenever the fallback is used.
 pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, String> {
     let mut tried = Vec::new();
+    let mut candidates = Vec::new();
     if let Some(dir) = base_dir {
-        let p = dir.join(name);
-        if p.is_file() {
-            return Ok(p);
-        }
-        tried.push(if dir.as_os_str().is_empty() {
-            ".".to_string()
-        } else {
-            dir.display().to_string()
-        });
+        candidates.push(dir.join(name));
+        tried.push(if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
     }
-    let p = PathBuf::from(name);
-    if p.is_file() {
-        return Ok(p);
-    }
+    candidates.push(PathBuf::from(name));
     tried.push("the current folder".to_string());
-    Err(format!(
-        "file not found (looked in {})",
-        tried.join(" and ")
-    ))
+    for p in candidates {
+        match file_kind(&p) {
+            FileKind::Missing => continue,
+            FileKind::Regular => return Ok(p),
+            other => return Err(format!("{} {}", p.display(), other.describe())),
+        }
+    }
+    Err(format!("file not found (looked in {})", tried.join(" and ")))
 }
 
 /// Meshes already loaded, by canonical path; reused while the file is unchanged on disk.
@@ -76,12 +79,26 @@ impl MeshCache {
     }
 }
 
-/// Reads one OBJ file into a single mesh (all its objects and groups together).
+/// Reads one OBJ file into a single mesh (all its objects and groups together). Only regular
+/// files are read (a FIFO is never opened), at most `MAX_OBJ_BYTES` of them.
 pub fn load_obj(path: &Path) -> Result<Mesh, String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    let (positions, triangles) = match fast::parse(&bytes) {
+    use std::io::Read as _;
+    let file = open_regular(path)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_OBJ_BYTES as u64 + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    if bytes.len() > MAX_OBJ_BYTES {
+        return Err(format!("the file is larger than {} MiB, the most tracelab reads as an OBJ mesh", MAX_OBJ_BYTES >> 20));
+    }
+    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    parse_obj(&bytes, &name)
+}
+
+/// Parses OBJ text (`name` is used in messages): the fast reader when it understands the
+/// file, else tobj.
+pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, String> {
+    let (positions, triangles) = match fast::parse(bytes) {
         Some(r) => r,
-        None => load_with_tobj(path)?,
+        None => load_with_tobj(bytes, name)?,
     };
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
         return Err(format!("vertex {} is not finite", i + 1));
@@ -89,33 +106,31 @@ pub fn load_obj(path: &Path) -> Result<Mesh, String> {
     Ok(Mesh::new(positions, triangles))
 }
 
+/// Positions and triangles as the fast reader gives them, or None when it defers to tobj.
+pub fn parse_obj_fast(bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
+    fast::parse(bytes)
+}
+
 /// The reference reader: every OBJ feature tobj knows, all objects and groups merged.
-fn load_with_tobj(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, _materials) = match tobj::load_obj(path, &opts) {
+/// `mtllib` files are never opened: tracelab shades with the scene's materials, and a
+/// material library could be a FIFO or a device.
+pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let no_materials = |_: &Path| -> tobj::MTLLoadResult { Err(tobj::LoadError::OpenFileFailed) };
+    let (models, _materials) = match tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials) {
         Ok(r) => r,
-        Err(e) => return Err(locate_obj_error(path).unwrap_or_else(|| e.to_string())),
+        Err(e) => return Err(locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string())),
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     for m in &models {
         let base = positions.len() as u32;
-        positions.extend(
-            m.mesh
-                .positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
         let nv = positions.len() as u32;
         for t in m.mesh.indices.chunks_exact(3) {
             let tri = [t[0] + base, t[1] + base, t[2] + base];
             if tri.iter().any(|&i| i >= nv) {
-                return Err(locate_obj_error(path)
+                return Err(locate_obj_error(bytes, name)
                     .unwrap_or_else(|| "a face refers to a vertex that does not exist".into()));
             }
             triangles.push(tri);
@@ -125,13 +140,8 @@ fn load_with_tobj(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
 }
 
 /// tobj's errors carry no line; find the first line that is wrong, to say where.
-fn locate_obj_error(path: &Path) -> Option<String> {
-    let bytes = std::fs::read(path).ok()?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let text = match std::str::from_utf8(&bytes) {
+fn locate_obj_error(bytes: &[u8], name: &str) -> Option<String> {
+    let text = match std::str::from_utf8(bytes) {
         Ok(t) => t,
         Err(e) => {
             let line = bytes[..e.valid_up_to()]
@@ -222,7 +232,7 @@ mod tests {
     fn same_geometry(path: &Path) {
         let bytes = std::fs::read(path).expect("read");
         let (fp, ft) = fast::parse(&bytes).expect("fast reader accepts the file");
-        let (tp, tt) = load_with_tobj(path).expect("tobj");
+        let (tp, tt) = load_with_tobj(&bytes, "t.obj").expect("tobj");
         assert_eq!(ft.len(), tt.len(), "{}", path.display());
         for (k, (a, b)) in ft.iter().zip(&tt).enumerate() {
             let pa = a.map(|i| fp[i as usize]);

@@ -11,6 +11,7 @@ use glam::{Mat4, Vec3};
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
 use super::lexer::{Comment, TokKind, Token, tokenize_with_comments};
 use super::obj::{MeshCache, resolve_obj_path};
+
 use crate::scene::{
     Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node,
     NodeId, NodeKind, Scene, SceneComments, TransformOp, check_closed, compose,
@@ -44,23 +45,34 @@ impl ParseOutcome {
     }
 }
 
+/// The largest scene file read. Scenes are hand-written or generated text (meshes live in OBJ
+/// files); the cap keeps a device, a FIFO or a mistaken huge file from filling memory.
+pub const MAX_SCENE_BYTES: usize = 64 << 20;
+
 /// Reads and parses a scene file; OBJ paths resolve against the file's folder first.
 pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
     let name = path.display().to_string();
-    match std::fs::read(path) {
-        Ok(bytes) => parse_scene(&bytes, &name, path.parent(), cache),
-        Err(e) => ParseOutcome {
-            scene: None,
-            diagnostics: Diagnostics(vec![Diagnostic {
-                severity: Severity::Error,
-                file: name,
-                line: 0,
-                col: 0,
-                message: format!("cannot read scene file: {e}"),
-            }]),
-            lost_comments: Vec::new(),
-        },
+    let whole_file_error = |message: String| ParseOutcome {
+        scene: None,
+        diagnostics: Diagnostics(vec![Diagnostic { severity: Severity::Error, file: name.clone(), line: 0, col: 0, message }]),
+        lost_comments: Vec::new(),
+    };
+    match read_capped(path, MAX_SCENE_BYTES) {
+        Ok(Some(bytes)) => parse_scene(&bytes, &name, path.parent(), cache),
+        Ok(None) => whole_file_error(format!("the file is larger than {} MiB, the most tracelab reads as a scene", MAX_SCENE_BYTES >> 20)),
+        Err(e) => whole_file_error(format!("cannot read scene file: {e}")),
     }
+}
+
+/// The file's bytes, or None when it holds more than `cap`. Reads at most `cap + 1` bytes, so
+/// a character device or a FIFO that never ends cannot be read forever.
+pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec<u8>>> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path)?;
+    let hint = file.metadata().map_or(0, |m| m.len()).min(cap as u64 + 1) as usize;
+    let mut bytes = Vec::with_capacity(hint);
+    file.take(cap as u64 + 1).read_to_end(&mut bytes)?;
+    Ok((bytes.len() <= cap).then_some(bytes))
 }
 
 /// Parses scene text. `name` is used in messages; `base_dir` is where OBJ files are looked
@@ -97,6 +109,7 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         scene_comments: SceneComments::default(),
         pos: 0,
         diags: Vec::new(),
+        unshown: Unshown::default(),
         fatal: false,
         base_dir,
         cache,
@@ -128,6 +141,7 @@ struct Parser<'a> {
     scene_comments: SceneComments,
     pos: usize,
     diags: Vec<Diagnostic>,
+    unshown: Unshown,
     /// Set by any error that leaves the scene incomplete.
     fatal: bool,
     base_dir: Option<&'a Path>,
@@ -149,6 +163,20 @@ struct Parser<'a> {
     /// Closedness already checked, per mesh (by address), so a mesh used many times is
     /// checked once.
     closed_meshes: HashMap<usize, Result<(), String>>,
+}
+
+/// Errors (and, separately, warnings) past this many are counted, not shown: a file of a
+/// million stray braces must not print a million lines.
+const MAX_SHOWN: usize = 20;
+
+/// Diagnostics beyond the first `MAX_SHOWN` of their severity: how many, and where the first
+/// of them is.
+#[derive(Default)]
+struct Unshown {
+    shown_errors: usize,
+    shown_warnings: usize,
+    errors: (usize, usize),
+    warnings: (usize, usize),
 }
 
 /// One `name value…` line inside a flat block.
@@ -280,6 +308,14 @@ impl<'a> Parser<'a> {
         &text[t.start..t.end]
     }
 
+    /// The word that starts at `offset`, as written (for quoting numbers in messages).
+    fn word_at(&self, offset: usize) -> &'a str {
+        let text: &'a str = self.src.text;
+        let rest = text.get(offset..).unwrap_or("");
+        let end = rest.find(|c: char| c.is_ascii_whitespace() || matches!(c, '{' | '}' | '#')).unwrap_or(rest.len());
+        &rest[..end]
+    }
+
     /// How a token reads in a "found …" message.
     fn describe(&self, t: Option<Token>) -> (String, usize) {
         match t {
@@ -290,18 +326,45 @@ impl<'a> Parser<'a> {
 
     fn error(&mut self, offset: usize, msg: impl Into<String>) {
         self.fatal = true;
-        let d = self.src.diagnostic(Severity::Error, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Error, offset, msg);
     }
 
     fn node_error(&mut self, offset: usize, msg: impl Into<String>) {
-        let d = self.src.diagnostic(Severity::Error, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Error, offset, msg);
     }
 
     fn warn(&mut self, offset: usize, msg: impl Into<String>) {
-        let d = self.src.diagnostic(Severity::Warning, offset, msg);
-        self.diags.push(d);
+        self.report(Severity::Warning, offset, msg);
+    }
+
+    fn report(&mut self, severity: Severity, offset: usize, msg: impl Into<String>) {
+        let u = &mut self.unshown;
+        let (shown, unshown) = match severity {
+            Severity::Error => (&mut u.shown_errors, &mut u.errors),
+            Severity::Warning => (&mut u.shown_warnings, &mut u.warnings),
+        };
+        if *shown < MAX_SHOWN {
+            *shown += 1;
+            let d = self.src.diagnostic(severity, offset, msg);
+            self.diags.push(d);
+        } else {
+            if unshown.0 == 0 {
+                unshown.1 = offset;
+            }
+            unshown.0 += 1;
+        }
+    }
+
+    /// "… and N more", located at the first diagnostic left out.
+    fn summarise_unshown(&mut self) {
+        let u = &self.unshown;
+        for (severity, (n, at), what) in [(Severity::Error, u.errors, "error"), (Severity::Warning, u.warnings, "warning")] {
+            if n > 0 {
+                let s = if n == 1 { "" } else { "s" };
+                let d = self.src.diagnostic(severity, at, format!("… and {n} more {what}{s}"));
+                self.diags.push(d);
+            }
+        }
     }
 
     /// Skips to just past the `}` that closes a block whose `{` was already read.
@@ -496,7 +559,8 @@ impl<'a> Parser<'a> {
             return None;
         }
         if f.values.len() > n {
-            let (extra, off) = (f.values[n].0, f.values[n].1);
+            let off = f.values[n].1;
+            let extra = self.word_at(off);
             self.error(off, format!("\"{name}\" takes {n} number(s); found an extra \"{extra}\""));
             return None;
         }
@@ -696,6 +760,21 @@ impl<'a> Parser<'a> {
         let open = self.expect_open(kw)?;
         let (mut f, end) = self.read_fields(kw, open)?;
         let diffuse = self.take_vec3(&mut f, kw, off, "diffuseColor")?;
+        let mut ok = true;
+        for (i, x) in f.iter().enumerate() {
+            let msg = if x.word.is_some() {
+                format!("\"{}\" belongs in TriangleMesh, not in {kw} (material fields take numbers)", x.name)
+            } else if f[..i].iter().any(|y| y.name == x.name) {
+                format!("\"{}\" is given twice in {kw}", x.name)
+            } else {
+                continue;
+            };
+            self.error(x.name_off, msg);
+            ok = false;
+        }
+        if !ok {
+            return None;
+        }
         let keyword = if kw == "PhongMaterial" { MaterialKeyword::PhongMaterial } else { MaterialKeyword::Material };
         // Other fields (specularColor, exponent, …) are kept, not shaded with.
         let extra = f
@@ -1218,7 +1297,8 @@ impl<'a> Parser<'a> {
         for (i, at) in std::mem::take(&mut self.material_refs) {
             if i as usize >= n {
                 let range = if n == 0 { "the scene has no materials".to_string() } else { format!("valid indices are 0 to {}", n - 1) };
-                self.error(at, format!("MaterialIndex {i} is out of range: {range}"));
+                let written = self.word_at(at);
+                self.error(at, format!("MaterialIndex {written} is out of range: {range}"));
             }
         }
         if self.camera.is_none() && !self.camera_seen {
@@ -1243,6 +1323,7 @@ impl<'a> Parser<'a> {
                 self.warn(*at, "no MaterialIndex applies to this object; it uses the default grey material");
             }
         }
+        self.summarise_unshown();
         let scene = if self.fatal {
             None
         } else {
