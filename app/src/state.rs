@@ -349,6 +349,7 @@ mod tests {
         let w = doc.save_warnings(&d.join("scenes/s.txt"));
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("s.txt:2:") && w[0].contains("comment"), "{w:?}");
+    }
 
     fn empty_dir(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("tracelab-state-io-{}-{name}", std::process::id()));
