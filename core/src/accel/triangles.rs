@@ -431,6 +431,9 @@ impl TriangleBvh {
         if self.nodes.is_empty() {
             return;
         }
+        if !finite_ray(ray.origin.into(), ray.direction.into()) {
+            return; // as in `closest_hit`
+        }
         let r = RayPre::new(ray.origin.into(), ray.direction.into());
         let mut stack = RayStack::new();
         let mut tn = [0.0f32; WIDTH];
@@ -473,6 +476,11 @@ impl TriangleBvh {
     /// store forward (Stanford bunny 12.1 -> 12.6 Mrays/s, medians of 7, same minute).
     #[inline]
     pub fn closest_hit(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        // A NaN or infinite ray (an overflowing object-space transform) makes every slab
+        // test NaN, which would enter the empty slots, whose child is the root: endless.
+        if !finite_ray(o, d) {
+            return None;
+        }
         #[cfg(target_arch = "x86_64")]
         if has_avx() {
             #[allow(unsafe_code)]
@@ -718,6 +726,13 @@ impl TriangleBvh {
     fn intersect_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         closest_hit!(self, o, d, t_min, t_max, slab8_avx, leaf8_avx)
     }
+}
+
+/// Whether a ray can be traversed: with finite origin and direction an empty slot's box
+/// (+inf..-inf) gives an infinite, never NaN, slab on every axis, so it is never entered.
+#[inline(always)]
+fn finite_ray(o: Vec3A, d: Vec3A) -> bool {
+    o.is_finite() && d.is_finite()
 }
 
 /// Whether the AVX traversal and leaf test run here.
@@ -1423,6 +1438,34 @@ mod tests {
                 .collect();
             assert_eq!(got, want, "ray {k}");
         }
+    }
+
+    /// Rays with NaN or infinite parts (an overflowing transform) used to loop forever: the
+    /// NaN slab entered the empty slots, whose child is the root. Run on a thread so a
+    /// regression fails instead of hanging the test run.
+    #[test]
+    fn non_finite_rays_miss_and_return() {
+        let (pos, tris) = random_mesh(300, 9);
+        let bvh = build_checked(&pos, &tris);
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let (n, i) = (f32::NAN, f32::INFINITY);
+            let rays = [
+                (Vec3::new(n, 0.0, -5.0), Vec3::Z),
+                (Vec3::new(0.0, 0.0, -5.0), Vec3::new(n, n, n)),
+                (Vec3::new(0.0, 0.0, -5.0), Vec3::new(i, i, i)),
+                (Vec3::new(i, -i, i), Vec3::new(0.0, 0.0, 1.0)),
+            ];
+            let mut all = Vec::new();
+            let mut hits = 0;
+            for (o, d) in rays {
+                hits += bvh.intersect(&Ray::new(o, d), 0.0, f32::INFINITY).is_some() as usize;
+                bvh.intersect_all(&Ray::new(o, d), 0.0, f32::INFINITY, &mut all);
+            }
+            let _ = tx.send((hits, all.len()));
+        });
+        let got = rx.recv_timeout(std::time::Duration::from_secs(10));
+        assert_eq!(got, Ok((0, 0)), "non-finite rays must miss, and return");
     }
 
     /// Packets of the eight rays `rays[k..k + 8]` under every `active` mask in `masks`: each
