@@ -8,9 +8,10 @@
 //! removed. A symlink is followed and its target written, so the link stays a link. A device
 //! node or FIFO is not replaced but written into, and its errors (a full device) reported.
 //!
-//! Why `tempfile` and not Linux's `O_TMPFILE`: it builds on every platform the editor runs
-//! on and needs no `unsafe` or raw system calls; the cost is that a `kill -9` between
-//! creating and renaming leaves one `.tracelab-*.tmp` file in the target's folder.
+//! On Linux the temporary file is unnamed (`O_TMPFILE`) while it is written and gets its
+//! name only when complete, just before the rename, so a `kill -9` during the write leaves
+//! nothing behind. Elsewhere, or on a file system without `O_TMPFILE`, it is a `tempfile`
+//! named file, and a `kill -9` between creating and renaming leaves one `.tracelab-*.tmp`.
 
 use std::fs::{File, Metadata};
 use std::io::{self, Write};
@@ -163,6 +164,12 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    #[cfg(target_os = "linux")]
+    if let Some(name) = target.file_name()
+        && let Some(done) = unnamed::replace(dir, name, existing, bytes)
+    {
+        return done;
+    }
     let mut builder = tempfile::Builder::new();
     builder.prefix(".tracelab-").suffix(".tmp");
     #[cfg(unix)]
@@ -178,9 +185,103 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
         keep_mode_and_owner(tmp.as_file(), meta)?;
     }
     tmp.as_file().sync_all()?;
+    test_stall();
     // On failure the PersistError gives the temporary file back; dropping it removes it.
     tmp.persist(target).map_err(|e| e.error)?;
     sync_dir(dir)
+}
+
+/// Test hook: with `TRACELAB_TEST_STALL_BEFORE_RENAME` set, stop for a minute once the
+/// bytes are written and synced but not yet in place, so a test can kill the process at
+/// exactly the moment that matters (tests/cli.rs). Says so on stderr.
+fn test_stall() {
+    if std::env::var_os("TRACELAB_TEST_STALL_BEFORE_RENAME").is_some() {
+        eprintln!("tracelab: test hook: stalled before rename");
+        std::thread::sleep(std::time::Duration::from_secs(60));
+    }
+}
+
+/// The Linux path: `O_TMPFILE`, then `linkat` to a fresh name and `renameat` over the target.
+#[cfg(target_os = "linux")]
+mod unnamed {
+    use std::ffi::OsStr;
+    use std::fs::{File, Metadata};
+    use std::io::{self, Write};
+    use std::os::fd::AsRawFd;
+    use std::path::Path;
+
+    use rustix::fs::{AtFlags, CWD, Mode, OFlags};
+    use rustix::io::Errno;
+
+    /// None where the folder's file system (or a missing /proc) does not allow an unnamed
+    /// file to be linked: the caller then uses a named temporary file.
+    pub fn replace(
+        dir: &Path,
+        name: &OsStr,
+        existing: Option<&Metadata>,
+        bytes: &[u8],
+    ) -> Option<io::Result<()>> {
+        let folder = match File::open(dir) {
+            Ok(f) => f,
+            Err(e) => return Some(Err(e)),
+        };
+        // 0666 less the umask, as for any new file.
+        let flags = OFlags::WRONLY | OFlags::TMPFILE | OFlags::CLOEXEC;
+        let fd = match rustix::fs::openat(&folder, ".", flags, Mode::from_raw_mode(0o666)) {
+            Ok(fd) => fd,
+            Err(Errno::OPNOTSUPP | Errno::ISDIR | Errno::INVAL | Errno::NOENT) => return None,
+            Err(e) => return Some(Err(e.into())),
+        };
+        let mut file = File::from(fd);
+        let written = (|| {
+            file.write_all(bytes)?;
+            file.flush()?;
+            if let Some(meta) = existing {
+                super::keep_mode_and_owner(&file, meta)?;
+            }
+            file.sync_all()
+        })();
+        if let Err(e) = written {
+            return Some(Err(e)); // the unnamed file goes with its descriptor
+        }
+        super::test_stall();
+        let temp = link(&file, &folder)?;
+        let moved = match temp {
+            Ok(temp) => rustix::fs::renameat(&folder, &temp, &folder, name)
+                .map_err(io::Error::from)
+                .inspect_err(|_| {
+                    let _ = rustix::fs::unlinkat(&folder, &temp, AtFlags::empty());
+                }),
+            Err(e) => Err(e),
+        };
+        Some(moved.and_then(|()| folder.sync_all()))
+    }
+
+    /// Gives the unnamed file a fresh name in `folder` (linkat never replaces an existing
+    /// entry, so a planted file or link at that name is refused, not followed). None when
+    /// neither /proc nor AT_EMPTY_PATH (which needs privilege) can name it.
+    fn link(file: &File, folder: &File) -> Option<io::Result<String>> {
+        let proc_path = format!("/proc/self/fd/{}", file.as_raw_fd());
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        for attempt in 0..100u32 {
+            let temp = format!(".tracelab-{}-{stamp:x}-{attempt}.tmp", std::process::id());
+            let linked =
+                rustix::fs::linkat(CWD, proc_path.as_str(), folder, temp.as_str(), AtFlags::SYMLINK_FOLLOW)
+                    .or_else(|e| match e {
+                        Errno::NOENT => rustix::fs::linkat(file, "", folder, temp.as_str(), AtFlags::EMPTY_PATH),
+                        e => Err(e),
+                    });
+            match linked {
+                Ok(()) => return Some(Ok(temp)),
+                Err(Errno::EXIST) => continue,
+                Err(Errno::NOENT | Errno::PERM | Errno::ACCESS) => return None,
+                Err(e) => return Some(Err(e.into())),
+            }
+        }
+        Some(Err(io::Error::other("no free temporary name")))
+    }
 }
 
 /// Gives the new file the mode of the one it replaces and, where allowed, its owner.

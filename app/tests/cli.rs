@@ -376,3 +376,42 @@ fn negative_depth_ranges_are_accepted_in_both_spellings() {
     // A negative size is now "invalid value", still a usage error.
     assert_eq!(tracelab(&["render", "--size", "-1", "5", "--output", "x.png"], &d).status.code(), Some(2));
 }
+
+/// `kill -9` while `fmt -o` is writing: the old file stays whole and no temporary file is
+/// left in its folder (on Linux the temporary file has no name until it is complete). The
+/// test hook stops the write once its bytes are out but before the rename, the moment a
+/// named temporary file would be left behind.
+#[cfg(target_os = "linux")]
+#[test]
+fn kill_9_during_fmt_o_leaves_the_old_file_and_no_temporary_file() {
+    use std::io::{BufRead, BufReader};
+    let d = temp_dir("kill9");
+    std::fs::copy(repo().join("scenes/default.txt"), d.join("in.txt")).expect("copy scene");
+    std::fs::write(d.join("out.txt"), "old contents").expect("write");
+    for image in [false, true] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_tracelab"));
+        if image {
+            std::fs::write(d.join("out.png"), "old image").expect("write");
+            cmd.args(["render", "in.txt", "--size", "8", "8", "--output", "out.png"]);
+        } else {
+            cmd.args(["fmt", "in.txt", "-o", "out.txt"]);
+        }
+        let mut child = cmd
+            .current_dir(&d)
+            .env("TRACELAB_TEST_STALL_BEFORE_RENAME", "1")
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run tracelab");
+        let mut line = String::new();
+        BufReader::new(child.stderr.take().expect("stderr")).read_line(&mut line).expect("read stderr");
+        assert!(line.contains("stalled before rename"), "{line}");
+        child.kill().expect("kill -9");
+        let _ = child.wait();
+    }
+    let mut names: Vec<String> =
+        std::fs::read_dir(&d).expect("read dir").map(|e| e.expect("entry").file_name().to_string_lossy().into()).collect();
+    names.sort();
+    assert_eq!(names, ["in.txt", "out.png", "out.txt"], "a temporary file was left behind");
+    assert_eq!(std::fs::read_to_string(d.join("out.txt")).expect("read"), "old contents");
+    assert_eq!(std::fs::read_to_string(d.join("out.png")).expect("read"), "old image");
+}
