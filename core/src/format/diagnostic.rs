@@ -89,7 +89,10 @@ impl std::error::Error for Diagnostics {}
 pub struct SourceFile<'a> {
     pub name: &'a str,
     pub text: &'a str,
-    line_starts: Vec<usize>,
+    /// Byte offsets where lines start, built on the first lookup (a file without errors
+    /// never pays for it) at 4 bytes a line, exactly sized: a file of newlines would
+    /// otherwise cost 24 bytes per byte of text.
+    line_starts: std::cell::OnceCell<Vec<u32>>,
     /// The last offset looked up, as (line index, offset, column): the parser reports in
     /// file order, so counting characters on from there keeps many errors on one long line
     /// linear instead of quadratic.
@@ -98,20 +101,32 @@ pub struct SourceFile<'a> {
 
 impl<'a> SourceFile<'a> {
     pub fn new(name: &'a str, text: &'a str) -> Self {
-        let mut line_starts = vec![0];
-        line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        SourceFile { name, text, line_starts, cursor: Cell::new((0, 0, 0)) }
+        SourceFile { name, text, line_starts: std::cell::OnceCell::new(), cursor: Cell::new((0, 0, 0)) }
+    }
+
+    fn line_starts(&self) -> &[u32] {
+        self.line_starts.get_or_init(|| {
+            // Offsets past 4 GiB (never a scene file: those are capped far below) are left
+            // out, so such lines count as part of the last line listed.
+            let newline = |(i, &b): (usize, &u8)| (b == b'\n').then(|| u32::try_from(i + 1).ok()).flatten();
+            let n = self.text.as_bytes().iter().enumerate().filter_map(newline).count();
+            let mut v = Vec::with_capacity(n + 1);
+            v.push(0);
+            v.extend(self.text.as_bytes().iter().enumerate().filter_map(newline));
+            v
+        })
     }
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (u32, u32) {
         let offset = offset.min(self.text.len());
-        let line = self.line_starts.partition_point(|&s| s <= offset).saturating_sub(1);
+        let starts = self.line_starts();
+        let line = starts.partition_point(|&s| s as usize <= offset).saturating_sub(1);
         let (c_line, c_off, c_col) = self.cursor.get();
         let (from, base) = if c_line == line && c_off <= offset {
             (c_off, c_col)
         } else {
-            (self.line_starts.get(line).copied().unwrap_or(0), 0)
+            (starts.get(line).map_or(0, |&s| s as usize), 0)
         };
         let counted = self.text.get(from..offset).map_or(offset - from, |s| s.chars().count());
         let col = base.saturating_add(u32::try_from(counted).unwrap_or(u32::MAX));

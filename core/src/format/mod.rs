@@ -6,6 +6,7 @@ mod lexer;
 pub mod obj;
 mod parser;
 mod rebase;
+mod token_stream;
 mod writer;
 
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile, escape_controls};

@@ -9,7 +9,8 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
-use super::lexer::{Comment, TokKind, Token, tokenize_with_comments};
+use super::lexer::{TokKind, Token};
+use super::token_stream::TokenStream;
 use super::obj::{MeshCache, resolve_obj_path};
 
 use crate::scene::{
@@ -98,11 +99,9 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
             return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]), lost_comments: Vec::new() };
         }
     };
-    let (toks, comments) = tokenize_with_comments(text);
     let mut p = Parser {
         src: SourceFile::new(name, text),
-        toks,
-        comments,
+        toks: TokenStream::new(text),
         next_comment: 0,
         pending_comments: Vec::new(),
         lost_comments: Vec::new(),
@@ -131,9 +130,9 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
 
 struct Parser<'a> {
     src: SourceFile<'a>,
-    toks: Vec<Token>,
-    /// Comments in file order; those before `next_comment` have been attached or lost.
-    comments: Vec<Comment>,
+    /// Tokens and comments, lexed as the parser reaches them; comments before
+    /// `next_comment` have been attached or lost.
+    toks: TokenStream<'a>,
     next_comment: usize,
     /// Comments before a MaterialIndex, waiting for the object it applies to.
     pending_comments: Vec<String>,
@@ -178,6 +177,10 @@ struct Unshown {
     errors: (usize, usize),
     warnings: (usize, usize),
 }
+
+/// Numbers one field may hold: far above the grammar's largest (Matrix, 16), and small
+/// enough that a field of millions of numbers is refused rather than held.
+const MAX_FIELD_NUMBERS: usize = 1024;
 
 /// One `name value…` line inside a flat block.
 struct Field {
@@ -255,7 +258,7 @@ impl<'a> Parser<'a> {
     // ---------------------------------------------------------------- tokens and messages
 
     fn peek(&self) -> Option<Token> {
-        self.toks.get(self.pos).copied()
+        self.toks.get(self.pos)
     }
 
     fn next(&mut self) -> Option<Token> {
@@ -271,7 +274,7 @@ impl<'a> Parser<'a> {
     /// took stood inside something (between a keyword and its value) and are lost.
     fn comments_before(&mut self, tok: usize) -> Vec<String> {
         let mut out = std::mem::take(&mut self.pending_comments);
-        while let Some(c) = self.comments.get(self.next_comment).copied() {
+        while let Some(c) = self.toks.comment(self.next_comment) {
             if c.next_token > tok {
                 break;
             }
@@ -518,15 +521,25 @@ impl<'a> Parser<'a> {
                             }
                         }
                     } else {
+                        let mut too_many = None;
                         while let Some(v) = self.peek().filter(|v| v.kind == TokKind::Word) {
                             if !is_numberlike(self.text(v)) {
                                 break;
                             }
                             self.pos += 1;
+                            if field.values.len() == MAX_FIELD_NUMBERS {
+                                // Skipped, not kept: memory stays bounded by what a scene keeps.
+                                too_many.get_or_insert(v.start);
+                                continue;
+                            }
                             match self.number_token(v, name) {
                                 Some(x) => field.values.push((x, v.start)),
                                 None => ok = false,
                             }
+                        }
+                        if let Some(off) = too_many {
+                            self.error(off, format!("\"{name}\" takes at most {MAX_FIELD_NUMBERS} numbers"));
+                            ok = false;
                         }
                     }
                     field.after = self.describe(self.peek());
