@@ -23,13 +23,20 @@ fn median(mut v: Vec<f64>) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
+/// `println!` that checks the write (a full disk is an error, a closed pipe ends the run).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        crate::cli::write_stdout(format!("{}\n", format_args!($($arg)*)).as_bytes())?
+    };
+}
+
 pub fn run(b: &BenchArgs) -> Result<(), CliError> {
     let (w, h) = (b.size[0], b.size[1]);
     check_size(w, h)?;
     let t_load = Instant::now();
     let scene = load(Some(&b.scene))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
-    println!(
+    out!(
         "load: {load_ms:.1} ms for the scene, its OBJ files and their BVHs, {} threads",
         rayon::current_num_threads()
     );
@@ -40,7 +47,7 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         std::hint::black_box(TriangleBvh::build(&m.positions, &m.triangles));
     }
     for m in &meshes {
-        println!("bvh: {}", m.accel.shape());
+        out!("bvh: {}", m.accel.shape());
     }
     let compiled = CompiledScene::new(&scene);
     let build_ms = t_build.elapsed().as_secs_f64() * 1e3;
@@ -48,7 +55,7 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
     let tris: usize = meshes.iter().map(|m| m.triangle_count()).sum();
     let bytes: usize = meshes.iter().map(|m| m.memory_bytes()).sum();
     if tris > 0 {
-        println!(
+        out!(
             "mesh: {tris} triangles, {bytes} bytes for geometry + BVH ({:.1} bytes/triangle)",
             bytes as f64 / tris as f64
         );
@@ -132,7 +139,7 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         }
     };
     if b.packets {
-        println!("mode: PACKETS, 4x2 pixel tiles traced as 8-ray packets");
+        out!("mode: PACKETS, 4x2 pixel tiles traced as 8-ray packets");
     }
     run_frame(&mut buf); // warm-up
     let mut times = Vec::with_capacity(b.repeat);
@@ -151,7 +158,7 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         .map(|&t| t as f64)
         .sum();
     let mrays = (w as f64 * h as f64) / secs / 1e6;
-    println!(
+    out!(
         "frame: {w}x{h}, {} threads, median {:.3} ms of {}, best {:.3} ms ({:.3} Mrays/s)",
         rayon::current_num_threads(),
         secs * 1e3,
@@ -160,7 +167,7 @@ pub fn run(b: &BenchArgs) -> Result<(), CliError> {
         (w as f64 * h as f64) / best / 1e6
     );
     let mode = if b.packets { " mode=packets" } else { "" };
-    println!(
+    out!(
         "BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}"
     );
     Ok(())
@@ -214,11 +221,11 @@ pub fn run_progressive(b: &ProgressiveArgs) -> Result<(), CliError> {
     let runs: Vec<(f64, f64)> = (0..b.repeat.max(1)).map(|_| once()).collect();
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
-    println!(
+    out!(
         "frame: {w}x{h}, {} threads, medians of {}",
         rayon::current_num_threads(),
         runs.len()
     );
-    println!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
+    out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
     Ok(())
 }

@@ -140,6 +140,9 @@ pub enum CliError {
     Failed(String),
     /// A usage error already printed (by clap).
     UsagePrinted,
+    /// The reader of standard output went away (`| head`): it wanted no more, so stop
+    /// quietly with success, as a program killed by SIGPIPE would in a shell pipeline.
+    OutputClosed,
 }
 
 impl CliError {
@@ -147,6 +150,7 @@ impl CliError {
         match self {
             CliError::Usage(_) | CliError::UsagePrinted => ExitCode::from(2),
             CliError::Failed(_) => ExitCode::from(1),
+            CliError::OutputClosed => ExitCode::SUCCESS,
         }
     }
 }
@@ -161,7 +165,7 @@ pub fn main() -> ExitCode {
             match &e {
                 CliError::Usage(m) => print_err(&format!("tracelab: {m}\nTry 'tracelab --help'.\n")),
                 CliError::Failed(m) => print_err(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" })),
-                CliError::UsagePrinted => {}
+                CliError::UsagePrinted | CliError::OutputClosed => {}
             }
             e.code()
         }
@@ -413,12 +417,13 @@ fn run_fmt(scene: &Path, output: Option<&Path>) -> Result<(), CliError> {
 }
 
 /// Writes to standard output, checking the write and the flush: a reader that closed the
-/// pipe (`| head`) wanted no more, which is no error; anything else (a full disk) is.
-fn write_stdout(bytes: &[u8]) -> Result<(), CliError> {
+/// pipe (`| head`) wanted no more, which ends the run quietly; anything else (a full disk)
+/// is an error.
+pub(crate) fn write_stdout(bytes: &[u8]) -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();
     match out.write_all(bytes).and_then(|()| out.flush()) {
         Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(CliError::OutputClosed),
         Err(e) => Err(CliError::Failed(format!("standard output: cannot write: {e}"))),
     }
 }

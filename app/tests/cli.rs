@@ -230,6 +230,39 @@ fn fmt_into_a_closed_pipe_ends_quietly() {
     assert!(o.stderr.is_empty(), "quiet: {}", stderr(&o));
 }
 
+/// `tracelab bench … | head`: a reader that has gone before the first figure ends the run
+/// quietly (it panicked with "failed printing to stdout: Broken pipe"). The pipe's read
+/// end is closed before the run starts, so every write meets the closed pipe.
+#[test]
+fn bench_into_a_closed_pipe_ends_quietly() {
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(["bench", "scenes/default.txt", "--size", "8", "8", "--repeat", "1"])
+        .current_dir(repo())
+        .stdout(writer)
+        .output()
+        .expect("run");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(o.stderr.is_empty(), "quiet: {}", stderr(&o));
+}
+
+#[cfg(unix)]
+#[test]
+fn bench_to_a_full_standard_output_is_an_error() {
+    let d = temp_dir("bench-full");
+    let Some(full) = mknod(&d, "full", 7) else { return };
+    let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(["bench", "scenes/default.txt", "--size", "8", "8", "--repeat", "1"])
+        .current_dir(repo())
+        .stdout(std::fs::OpenOptions::new().write(true).open(&full).expect("open private full device"))
+        .output()
+        .expect("run");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("standard output: cannot write"), "{}", stderr(&o));
+    assert!(is_char_device(&full));
+}
+
 #[cfg(unix)]
 #[test]
 fn fmt_to_a_full_standard_output_is_an_error() {
