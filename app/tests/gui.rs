@@ -1156,3 +1156,58 @@ fn save_says_which_comments_it_would_drop_before_writing() {
     assert_ne!(std::fs::read_to_string(&path).expect("read"), text);
     assert!(!h.state().doc.is_dirty());
 }
+
+fn layout_harness(width: f32, memory: Option<egui::Memory>) -> Harness<'static, TracelabApp> {
+    Harness::builder()
+        .with_size(egui::vec2(width, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            if let Some(m) = memory {
+                // What eframe restores from the last run, before the first frame.
+                cc.egui_ctx.memory_mut(|mem| *mem = m);
+            }
+            TracelabApp::new(Some(cc), AppOptions::default())
+        })
+}
+
+/// The x of the tree panel's resize handle (the leftmost one).
+fn tree_edge(h: &Harness<'static, TracelabApp>) -> f32 {
+    h.query_all_by_role(egui::accesskit::Role::Splitter)
+        .map(|n| n.rect().center().x)
+        .min_by(f32::total_cmp)
+        .expect("a panel resize handle")
+}
+
+fn render_width(h: &Harness<'static, TracelabApp>) -> u32 {
+    h.state().worker.with_published(|p| p.expect("rendered").job.settings.width)
+}
+
+#[test]
+fn a_remembered_1000_px_panel_is_clamped_and_reset_layout_restores_the_defaults() {
+    // Remembered on a wide screen, where a 1000 px tree still leaves room for the view...
+    let mut wide = layout_harness(2400.0, None);
+    for _ in 0..3 {
+        wide.step();
+    }
+    let handle = wide
+        .query_all_by_role(egui::accesskit::Role::Splitter)
+        .min_by(|a, b| a.rect().center().x.total_cmp(&b.rect().center().x))
+        .expect("handle");
+    handle.set_value_accesskit(1000.0 / 2400.0);
+    for _ in 0..3 {
+        wide.step();
+    }
+    assert!((tree_edge(&wide) - 1000.0).abs() < 10.0, "the tree is {} px wide", tree_edge(&wide));
+    let memory = wide.ctx.memory(|m| m.clone());
+    // ...and started on a 1200 px one.
+    let mut h = layout_harness(1200.0, Some(memory));
+    settle(&mut h);
+    assert!(render_width(&h) >= 300, "the render view is {} px wide", render_width(&h));
+    assert!(tree_edge(&h) < 1200.0 - 320.0);
+    h.get_by_label("View").click();
+    h.step();
+    h.get_by_label("Reset layout").click();
+    settle(&mut h);
+    assert!((tree_edge(&h) - 280.0).abs() < 10.0, "after Reset layout the tree is {} px wide", tree_edge(&h));
+    assert!(render_width(&h) > 500, "the view has its default room: {}", render_width(&h));
+}
