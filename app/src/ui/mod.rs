@@ -1,5 +1,6 @@
 //! The panels. Each reads the document and returns edits; `app.rs` applies them.
 
+pub mod drag_speed;
 pub mod file_dialog;
 pub mod inspector;
 pub mod pixel_inspector;
