@@ -43,7 +43,7 @@ fn harness(scene: &Path, size: (u32, u32)) -> Harness<'static, TracelabApp> {
     Harness::builder()
         .with_size(egui::vec2(1200.0, 760.0))
         .with_max_steps(10_000)
-        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(size) }))
+        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(size), ..AppOptions::default() }))
 }
 
 /// Steps until the scene is loaded and the renderer has finished the newest request, then
@@ -52,7 +52,7 @@ fn settle(h: &mut Harness<'static, TracelabApp>) {
     let start = Instant::now();
     loop {
         h.step();
-        if h.state().worker.is_idle() {
+        if h.state().worker.is_idle() && !h.state().is_loading() {
             h.step();
             return;
         }

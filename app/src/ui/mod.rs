@@ -3,6 +3,9 @@
 pub mod drag_speed;
 pub mod file_dialog;
 pub mod inspector;
+pub mod layout;
+pub mod loading;
+pub mod native_dialog;
 pub mod pixel_inspector;
 pub mod status;
 pub mod tree;
