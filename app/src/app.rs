@@ -5,13 +5,17 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::{RayStory, inspect_pixel};
-use tracelab_core::{RenderSettings, Scene};
+use tracelab_core::Scene;
+use tracelab_core::render::RayStory;
 
 use crate::edit::Edit;
+use crate::loading::{LoadPurpose, Loading};
 use crate::render_worker::RenderWorker;
-use crate::state::{Document, Selection};
+use crate::state::{Document, SceneRead, Selection, read_scene_file};
 use crate::ui::file_dialog::{FileDialog, Purpose};
+use crate::ui::layout::Layout;
+use crate::ui::native_dialog::{Answer, NativeDialog};
+use crate::ui::pixel_inspector::Inspected;
 use crate::ui::tree::TreeRow;
 use crate::ui::viewport::{Compare, Tab, ViewSettings, Viewport};
 use crate::ui::{inspector, pixel_inspector, status, tree};
@@ -22,13 +26,22 @@ pub struct AppOptions {
     pub scene: Option<PathBuf>,
     /// Render at this size instead of following the view (tests use small fixed sizes).
     pub fixed_size: Option<(u32, u32)>,
+    /// Use the desktop's file dialog where this build and desktop have one (the window does;
+    /// tests drive the built-in one).
+    pub native_dialogs: bool,
 }
 
-/// An action waiting for the user to decide about unsaved changes.
+/// An action waiting for the user to decide.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Pending {
+    /// Close the window, over unsaved changes.
     Close,
+    /// Switch to this file, already read, over unsaved changes.
     Open(PathBuf),
+    /// Start a new untitled scene, over unsaved changes.
+    New,
+    /// Write `path` although saving loses what `warnings` name; then carry on with `then`.
+    Save { path: PathBuf, warnings: Vec<String>, then: Option<Box<Pending>> },
 }
 
 const MAX_RECENT: usize = 10;
@@ -40,9 +53,25 @@ pub struct TracelabApp {
     viewport: Viewport,
     /// The last pixel inspected and the scene snapshot it was traced in.
     pub story: Option<(RayStory, Arc<Scene>)>,
+    /// Which pixel that is and the render it was traced in: every new render traces it again.
+    pub inspected: Option<Inspected>,
     pub pixel_inspector_open: bool,
     pub dialog: Option<FileDialog>,
+    native: Option<NativeDialog>,
+    native_dialogs: bool,
     pub confirm: Option<Pending>,
+    /// A file read while there were unsaved changes, waiting for the answer to `confirm`.
+    ready: Option<SceneRead>,
+    /// The file being read in the background, if any.
+    loading: Option<Loading>,
+    repaint: Arc<dyn Fn() + Send + Sync>,
+    layout: Layout,
+    /// Bumped whenever the document changes other than by the panels' own edits (open,
+    /// reload, New, undo, redo): the inspector's widgets get fresh ids, so no edit buffer
+    /// from before (a typed obj_file, a half-typed number) shows or is committed there.
+    widget_epoch: u64,
+    /// The document generation right after the panels' edits were applied.
+    panels_generation: u64,
     pub recent: Vec<PathBuf>,
     rows: (u64, Vec<TreeRow>, (usize, usize, usize)),
     last_disk_check: Instant,
@@ -65,9 +94,18 @@ impl TracelabApp {
             view: ViewSettings::default(),
             viewport: Viewport::default(),
             story: None,
+            inspected: None,
             pixel_inspector_open: false,
             dialog: None,
+            native: None,
+            native_dialogs: opts.native_dialogs,
             confirm: None,
+            ready: None,
+            loading: None,
+            repaint: Arc::new(|| {}),
+            layout: Layout::default(),
+            widget_epoch: 0,
+            panels_generation: 0,
             recent: Vec::new(),
             rows: (0, Vec::new(), (0, 0, 0)),
             last_disk_check: Instant::now(),
@@ -80,6 +118,8 @@ impl TracelabApp {
         if let Some(cc) = cc {
             let ctx = cc.egui_ctx.clone();
             app.worker.set_repaint(move || ctx.request_repaint());
+            let ctx = cc.egui_ctx.clone();
+            app.repaint = Arc::new(move || ctx.request_repaint());
             if let Some(s) = cc.storage {
                 app.load_persisted(s);
             }
@@ -87,8 +127,9 @@ impl TracelabApp {
         if opts.fixed_size.is_some() {
             app.view.fixed_size = opts.fixed_size;
         }
+        // Read in the background: the window paints at once, on the built-in scene.
         if let Some(p) = opts.scene {
-            app.open_now(&p);
+            app.open(&p);
         }
         app
     }
@@ -111,9 +152,15 @@ impl TracelabApp {
                 _ => Tab::Color,
             };
             self.view.shade_back = next() == "1";
-            if let (Ok(a), Ok(b)) = (next().parse(), next().parse()) {
+            if let (Ok(a), Ok(b)) = (next().parse::<f32>(), next().parse::<f32>())
+                && a.is_finite()
+                && b.is_finite()
+            {
                 self.view.depth = (a, b);
             }
+        }
+        if let Some(e) = s.get_string("layout").and_then(|l| l.trim().parse().ok()) {
+            self.layout.epoch = e;
         }
     }
 
@@ -124,60 +171,175 @@ impl TracelabApp {
         }
     }
 
-    /// Opens a file, asking first when there are unsaved changes.
+    /// Opens a file: reads it in the background, then switches to it, asking first when
+    /// there are unsaved changes. A file that does not parse is reported and nothing is
+    /// asked: there is nothing to switch to.
     pub fn open(&mut self, path: &Path) {
-        if self.doc.is_dirty() {
-            self.confirm = Some(Pending::Open(path.to_path_buf()));
-        } else {
-            self.open_now(path);
-        }
+        self.start_loading(path, LoadPurpose::Open);
     }
 
-    /// Opens a file now; on failure the current scene stays and the errors are shown.
+    /// Opens a file at once, blocking, without asking (scripts and tests; the window uses
+    /// [`Self::open`]). False when it could not be read: the current scene stays.
     pub fn open_now(&mut self, path: &Path) -> bool {
-        let ok = self.doc.open(path).is_ok();
-        if ok {
-            self.story = None;
-            self.viewport.marker = None;
-            self.disk_changed = false;
-            self.recent.retain(|r| r != path);
-            self.recent.insert(0, path.to_path_buf());
-            self.recent.truncate(MAX_RECENT);
-        }
-        ok
+        let read = read_scene_file(path, self.doc.mesh_cache.clone());
+        self.install(read, false)
     }
 
-    /// Re-reads the file from disk, keeping the selection when it still exists.
-    pub fn reload(&mut self) {
-        let Some(p) = self.doc.path.clone() else {
+    /// Whether a file is being read in the background.
+    pub fn is_loading(&self) -> bool {
+        self.loading.is_some()
+    }
+
+    fn start_loading(&mut self, path: &Path, purpose: LoadPurpose) {
+        // One read at a time: the newer request wins.
+        if let Some(old) = self.loading.take() {
+            old.cancel();
+        }
+        self.loading = Some(Loading::start(path, purpose, self.doc.mesh_cache.clone(), self.repaint.clone()));
+    }
+
+    /// Stops the background read; the open scene stays as it is.
+    pub fn cancel_loading(&mut self) {
+        if let Some(l) = self.loading.take() {
+            l.cancel();
+        }
+    }
+
+    /// Takes the background read's result when it is there.
+    fn poll_loading(&mut self) {
+        let Some(read) = self.loading.as_ref().and_then(Loading::poll) else {
             return;
         };
-        let sel = self.doc.selection;
-        if self.open_now(&p) {
-            self.doc.selection = sel;
+        let Some(loading) = self.loading.take() else {
+            return;
+        };
+        let ask = read.outcome.is_ok() && self.doc.is_dirty();
+        match loading.purpose {
+            LoadPurpose::Open | LoadPurpose::Refresh if ask => {
+                self.confirm = Some(Pending::Open(read.path.clone()));
+                self.ready = Some(read);
+            }
+            LoadPurpose::Open => {
+                self.install(read, false);
+            }
+            LoadPurpose::Reload | LoadPurpose::Refresh => {
+                self.install(read, true);
+            }
+        }
+    }
+
+    /// Makes a file read the document (or reports why it cannot be). `reload`: the same file
+    /// again, keeping the selection where it still exists.
+    fn install(&mut self, read: SceneRead, reload: bool) -> bool {
+        let path = read.path.clone();
+        let selection = self.doc.selection;
+        if self.doc.install(read).is_err() {
+            if reload {
+                // Not again until the file changes again.
+                self.doc.disk_stamp = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
+            }
+            return false;
+        }
+        self.story = None;
+        self.inspected = None;
+        self.viewport.marker = None;
+        self.disk_changed = false;
+        if reload {
+            self.doc.selection = selection.filter(|s| match s {
+                Selection::Node(id) => self.doc.scene.graph.path_to(*id).is_some(),
+                Selection::Light(i) => *i < self.doc.scene.lights().len(),
+                Selection::Material(i) => *i < self.doc.scene.materials.len(),
+                _ => true,
+            });
             self.doc
                 .messages
-                .insert(0, format!("{}: reloaded (changed on disk)", p.display()));
+                .insert(0, format!("{}: reloaded (changed on disk)", path.display()));
+        }
+        self.recent.retain(|r| r != &path);
+        self.recent.insert(0, path);
+        self.recent.truncate(MAX_RECENT);
+        true
+    }
+
+    /// Re-reads the file from disk (in the background), keeping the selection when it
+    /// still exists.
+    pub fn reload(&mut self) {
+        if let Some(p) = self.doc.path.clone() {
+            self.start_loading(&p, LoadPurpose::Reload);
+        }
+    }
+
+    /// File › New: the built-in scene, untitled, asking first about unsaved changes.
+    pub fn new_document(&mut self) {
+        if self.doc.is_dirty() {
+            self.confirm = Some(Pending::New);
+        } else {
+            self.new_now();
+        }
+    }
+
+    fn new_now(&mut self) {
+        self.cancel_loading();
+        let cache = std::mem::take(&mut self.doc.mesh_cache);
+        // Generations stay monotonic across documents: the worker compares them.
+        let generation = self.doc.generation + 1;
+        self.doc = Document::builtin();
+        self.doc.mesh_cache = cache;
+        self.doc.generation = generation;
+        self.story = None;
+        self.inspected = None;
+        self.viewport.marker = None;
+        self.disk_changed = false;
+    }
+
+    /// File › Quit (Ctrl+Q): closes the window, asking first about unsaved changes.
+    pub fn quit(&mut self, ctx: &egui::Context) {
+        if self.doc.is_dirty() {
+            self.confirm = Some(Pending::Close);
+        } else {
+            self.allow_close = true;
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
     }
 
     pub fn save(&mut self) {
-        if self.doc.path.is_none() {
-            self.dialog = Some(FileDialog::new(Purpose::SaveAs, None));
-            return;
-        }
-        if let Err(e) = self.doc.save() {
-            self.doc.messages.push(e);
+        match self.doc.path.clone() {
+            Some(p) => {
+                self.save_to(&p, None);
+            }
+            None => self.show_file_dialog(Purpose::SaveAs),
         }
     }
 
+    /// Saves to `path`; asks first when saving would lose something (comments that cannot
+    /// be kept, mesh paths that cannot be rewritten).
     pub fn save_as(&mut self, path: &Path) {
+        self.save_to(path, None);
+    }
+
+    /// True when written now. Otherwise the user is asked (then `then` follows a yes) or
+    /// the error is shown.
+    fn save_to(&mut self, path: &Path, then: Option<Pending>) -> bool {
+        let warnings = self.doc.save_warnings(path);
+        if !warnings.is_empty() {
+            self.confirm = Some(Pending::Save { path: path.to_path_buf(), warnings, then: then.map(Box::new) });
+            return false;
+        }
+        self.write(path)
+    }
+
+    fn write(&mut self, path: &Path) -> bool {
         match self.doc.save_as(path) {
             Ok(()) => {
                 self.recent.retain(|r| r != path);
                 self.recent.insert(0, path.to_path_buf());
+                self.recent.truncate(MAX_RECENT);
+                true
             }
-            Err(e) => self.doc.messages.push(e),
+            Err(e) => {
+                self.doc.messages.push(e);
+                false
+            }
         }
     }
 
@@ -232,30 +394,32 @@ impl TracelabApp {
         })
     }
 
-    /// Inspects a pixel of the image last published (the image on screen).
+    /// Inspects a pixel of the image last published (the image on screen) and selects
+    /// what it shows.
     pub fn inspect(&mut self, frame: usize, x: u32, row: u32) {
-        let found = self.worker.with_published(|p| {
-            let p = p?;
-            let mode = *p.job.modes.get(frame)?;
-            let settings = RenderSettings {
-                normal_transform: mode,
-                ..p.job.settings
-            };
-            Some((
-                inspect_pixel(&p.job.scene, &p.compiled, &settings, x, row),
-                p.job.scene.clone(),
-            ))
-        });
-        if let Some((story, scene)) = found {
+        let found = self.worker.with_published(|p| pixel_inspector::trace(p?, frame, x, row));
+        if let Some((at, story, scene)) = found {
             if let Some(h) = &story.hit {
                 // Ids are stable across edits that do not delete the node.
                 if self.doc.scene.graph.path_to(h.node).is_some() {
                     self.doc.selection = Some(Selection::Node(h.node));
                 }
             }
-            self.viewport.marker = Some((x, row));
+            self.viewport.marker = Some((at.x, at.row));
+            self.inspected = Some(at);
             self.story = Some((story, scene));
             self.pixel_inspector_open = true;
+        }
+    }
+
+    /// Traces the inspected pixel again when a newer render is published, so the story is
+    /// always that of the image on screen. The selection stays as the user left it.
+    fn follow_inspected(&mut self) {
+        let Some(at) = self.inspected else { return };
+        if let Some((at, story, scene)) = self.worker.with_published(|p| pixel_inspector::follow(p?, &at)) {
+            self.viewport.marker = Some((at.x, at.row));
+            self.inspected = Some(at);
+            self.story = Some((story, scene));
         }
     }
 
@@ -276,6 +440,34 @@ impl TracelabApp {
         );
     }
 
+    /// Opens a file dialog: the desktop's where there is one, else the built-in one.
+    pub fn show_file_dialog(&mut self, purpose: Purpose) {
+        let start = self.doc.path.clone();
+        if self.native_dialogs
+            && self.native.is_none()
+            && let Some(d) = NativeDialog::start(purpose, start.as_deref(), self.repaint.clone())
+        {
+            self.native = Some(d);
+            return;
+        }
+        self.dialog = Some(FileDialog::new(purpose, start.as_deref()));
+    }
+
+    /// What to do with a path a file dialog gave.
+    fn chosen(&mut self, purpose: Purpose, path: &Path) {
+        match purpose {
+            Purpose::Open => self.open(path),
+            Purpose::SaveAs => self.save_as(path),
+            Purpose::Export => match self.export(path) {
+                Ok(files) => self.doc.messages.push(format!(
+                    "exported {}",
+                    files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+                )),
+                Err(e) => self.doc.messages.push(e),
+            },
+        }
+    }
+
     fn shortcuts(&mut self, ctx: &egui::Context) {
         use egui::{Key, KeyboardShortcut, Modifiers};
         let cmd = Modifiers::COMMAND;
@@ -291,13 +483,19 @@ impl TracelabApp {
             self.doc.undo();
         }
         if pressed(cmd_shift, Key::S) {
-            self.dialog = Some(FileDialog::new(Purpose::SaveAs, self.doc.path.as_deref()));
+            self.show_file_dialog(Purpose::SaveAs);
         }
         if pressed(cmd, Key::S) {
             self.save();
         }
         if pressed(cmd, Key::O) {
-            self.dialog = Some(FileDialog::new(Purpose::Open, self.doc.path.as_deref()));
+            self.show_file_dialog(Purpose::Open);
+        }
+        if pressed(cmd, Key::N) {
+            self.new_document();
+        }
+        if pressed(cmd, Key::Q) {
+            self.quit(ctx);
         }
         if !ctx.egui_wants_keyboard_input()
             && ctx.input(|i| i.key_pressed(Key::Delete))
@@ -310,8 +508,11 @@ impl TracelabApp {
     fn menu(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
+                if ui.button("New (Ctrl+N)").clicked() {
+                    self.new_document();
+                }
                 if ui.button("Open… (Ctrl+O)").clicked() {
-                    self.dialog = Some(FileDialog::new(Purpose::Open, self.doc.path.as_deref()));
+                    self.show_file_dialog(Purpose::Open);
                 }
                 ui.menu_button("Open recent", |ui| {
                     if self.recent.is_empty() {
@@ -327,7 +528,7 @@ impl TracelabApp {
                     self.save();
                 }
                 if ui.button("Save As… (Ctrl+Shift+S)").clicked() {
-                    self.dialog = Some(FileDialog::new(Purpose::SaveAs, self.doc.path.as_deref()));
+                    self.show_file_dialog(Purpose::SaveAs);
                 }
                 if ui
                     .add_enabled(
@@ -339,7 +540,11 @@ impl TracelabApp {
                     self.reload();
                 }
                 if ui.button("Export view…").clicked() {
-                    self.dialog = Some(FileDialog::new(Purpose::Export, self.doc.path.as_deref()));
+                    self.show_file_dialog(Purpose::Export);
+                }
+                ui.separator();
+                if ui.button("Quit (Ctrl+Q)").clicked() {
+                    self.quit(ui.ctx());
                 }
             });
             ui.menu_button("Edit", |ui| {
@@ -361,11 +566,24 @@ impl TracelabApp {
             });
             ui.menu_button("View", |ui| {
                 ui.checkbox(&mut self.pixel_inspector_open, "Pixel inspector");
+                if ui
+                    .button("Reset layout")
+                    .on_hover_text("Panels back to their first sizes")
+                    .clicked()
+                {
+                    self.layout.reset();
+                    ui.close();
+                }
             });
         });
     }
 
     fn messages(&mut self, ui: &mut egui::Ui) {
+        if let Some(l) = &self.loading
+            && crate::ui::loading::ui(ui, l)
+        {
+            self.cancel_loading();
+        }
         if self.disk_changed {
             ui.horizontal(|ui| {
                 ui.colored_label(
@@ -408,87 +626,131 @@ impl TracelabApp {
         });
     }
 
+    /// Carries out an action the user agreed to.
+    fn carry_out(&mut self, pending: Pending, ctx: &egui::Context) {
+        match pending {
+            Pending::Close => {
+                self.allow_close = true;
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            Pending::Open(_) => {
+                if let Some(read) = self.ready.take() {
+                    self.install(read, false);
+                }
+            }
+            Pending::New => self.new_now(),
+            Pending::Save { path, then, .. } => {
+                if self.write(&path)
+                    && let Some(then) = then
+                {
+                    self.carry_out(*then, ctx);
+                }
+            }
+        }
+    }
+
     fn dialogs(&mut self, ctx: &egui::Context) {
+        if let Some(answer) = self.native.as_ref().and_then(NativeDialog::poll)
+            && let Some(d) = self.native.take()
+        {
+            match answer {
+                Answer::Chosen(p) => self.chosen(d.purpose, &p),
+                Answer::Cancelled => {}
+                Answer::Unavailable => {
+                    // This desktop has none after all: the built-in one, from now on.
+                    self.native_dialogs = false;
+                    self.show_file_dialog(d.purpose);
+                }
+            }
+        }
         if let Some(d) = &mut self.dialog {
             let purpose = d.purpose;
             if let Some(result) = d.ui(ctx) {
                 self.dialog = None;
                 if let Some(path) = result {
-                    match purpose {
-                        Purpose::Open => self.open(&path),
-                        Purpose::SaveAs => self.save_as(&path),
-                        Purpose::Export => match self.export(&path) {
-                            Ok(files) => self.doc.messages.push(format!(
-                                "exported {}",
-                                files
-                                    .iter()
-                                    .map(|f| f.display().to_string())
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            )),
-                            Err(e) => self.doc.messages.push(e),
-                        },
-                    }
+                    self.chosen(purpose, &path);
                 }
             }
         }
-        if let Some(pending) = self.confirm.clone() {
-            let mut choice = None;
-            egui::Modal::new(egui::Id::unique("unsaved-changes")).show(ctx, |ui| {
-                ui.heading("Unsaved changes");
-                ui.label(format!(
-                    "{} has changes that are not saved.",
-                    self.doc.title_name()
-                ));
-                ui.horizontal(|ui| {
-                    if ui.button("Save").clicked() {
-                        choice = Some(0);
+        match self.confirm.clone() {
+            Some(Pending::Save { path, warnings, then }) => {
+                let mut choice = None;
+                egui::Modal::new(egui::Id::unique("save-loses")).show(ctx, |ui| {
+                    ui.heading("Saving loses something");
+                    ui.label(format!("Saving {} cannot keep:", path.display()));
+                    for w in warnings.iter().take(8) {
+                        ui.label(w);
                     }
-                    if ui.button("Discard changes").clicked() {
-                        choice = Some(1);
+                    if warnings.len() > 8 {
+                        ui.label(format!("… and {} more", warnings.len() - 8));
                     }
-                    if ui.button("Cancel").clicked() {
-                        choice = Some(2);
-                    }
+                    ui.horizontal(|ui| {
+                        if ui.button("Save anyway").clicked() {
+                            choice = Some(true);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            choice = Some(false);
+                        }
+                    });
                 });
-            });
-            if let Some(c) = choice {
-                self.confirm = None;
-                if c == 0 {
-                    self.save();
-                    if self.doc.is_dirty() {
-                        return; // Save As dialog or a failed save: stay.
-                    }
-                }
-                if c <= 1 {
-                    match pending {
-                        Pending::Close => {
-                            self.allow_close = true;
-                            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                        }
-                        Pending::Open(p) => {
-                            self.open_now(&p);
-                        }
+                if let Some(yes) = choice {
+                    self.confirm = None;
+                    if yes {
+                        self.carry_out(Pending::Save { path, warnings, then }, ctx);
+                    } else if then.is_some() {
+                        // Not saved: whatever was to follow waits for another answer.
+                        self.ready = None;
                     }
                 }
             }
-        }
-        if self.pixel_inspector_open {
-            let mut open = true;
-            // Over the lower tree, leaving the render view free for the next click.
-            let at = ctx.content_rect().left_bottom() + egui::vec2(8.0, -30.0);
-            egui::Window::new("Pixel inspector")
-                .open(&mut open)
-                .default_width(520.0)
-                .pivot(egui::Align2::LEFT_BOTTOM)
-                .default_pos(at)
-                .show(ctx, |ui| match &self.story {
-                    Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
-                    None => {
-                        ui.label("Click a pixel in the render view.");
-                    }
+            Some(pending) => {
+                let mut choice = None;
+                egui::Modal::new(egui::Id::unique("unsaved-changes")).show(ctx, |ui| {
+                    ui.heading("Unsaved changes");
+                    ui.label(format!(
+                        "{} has changes that are not saved.",
+                        self.doc.title_name()
+                    ));
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            choice = Some(0);
+                        }
+                        if ui.button("Discard changes").clicked() {
+                            choice = Some(1);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            choice = Some(2);
+                        }
+                    });
                 });
-            self.pixel_inspector_open = open;
+                match choice {
+                    Some(0) => {
+                        self.confirm = None;
+                        match self.doc.path.clone() {
+                            Some(p) => {
+                                if self.save_to(&p, Some(pending.clone())) {
+                                    self.carry_out(pending, ctx);
+                                }
+                            }
+                            // Never saved: Save As first; the user repeats the action after.
+                            None => {
+                                self.ready = None;
+                                self.show_file_dialog(Purpose::SaveAs);
+                            }
+                        }
+                    }
+                    Some(1) => {
+                        self.confirm = None;
+                        self.carry_out(pending, ctx);
+                    }
+                    Some(_) => {
+                        self.confirm = None;
+                        self.ready = None;
+                    }
+                    None => {}
+                }
+            }
+            None => {}
         }
         if !self.pixel_inspector_open {
             self.viewport.marker = None;
@@ -501,11 +763,15 @@ impl TracelabApp {
             return;
         }
         self.last_disk_check = Instant::now();
+        // A read under way will set the stamp; asking again would restart it.
+        if self.loading.is_some() {
+            return;
+        }
         if !self.disk_changed && self.doc.changed_on_disk() {
             if self.doc.is_dirty() {
                 self.disk_changed = true;
-            } else {
-                self.reload();
+            } else if let Some(p) = self.doc.path.clone() {
+                self.start_loading(&p, LoadPurpose::Refresh);
             }
         }
     }
@@ -525,6 +791,7 @@ impl TracelabApp {
     fn frame_inner(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
+        self.poll_loading();
         self.watch_disk();
         // Files dropped onto the window.
         let dropped: Vec<PathBuf> = ctx.input(|i| {
@@ -543,9 +810,18 @@ impl TracelabApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.confirm = Some(Pending::Close);
         }
+        if ctx.input(|i| i.viewport().close_requested()) && self.loading.is_some() {
+            self.cancel_loading();
+        }
         if !ctx.input(|i| i.pointer.any_down()) {
             self.doc.end_gesture();
         }
+        if self.doc.generation != self.panels_generation {
+            // Changed by something other than the panels' own edits: fresh widget ids.
+            self.widget_epoch += 1;
+            self.panels_generation = self.doc.generation;
+        }
+        self.follow_inspected();
         let title = format!(
             "tracelab — {}{}",
             self.doc.title_name(),
@@ -572,27 +848,45 @@ impl TracelabApp {
             status::ui(ui, &self.doc, &self.worker, self.rows.2, self.show_timings)
         });
         let mut edits = Vec::new();
-        egui::Panel::left("tree")
-            .resizable(true)
-            .default_size(280.0)
-            .show(ui, |ui| {
-                ui.heading("Scene");
-                let rows = std::mem::take(&mut self.rows.1);
-                let reveal = match self.doc.selection {
-                    Some(Selection::Node(id)) if self.doc.selection != self.tree_seen => Some(id),
-                    _ => None,
-                };
-                edits.extend(tree::ui(ui, &mut self.doc, &rows, reveal));
-                self.tree_seen = self.doc.selection;
-                self.rows.1 = rows;
+        let total = ui.available_rect_before_wrap().width();
+        let tree = self.layout.tree_panel(total).show(ui, |ui| {
+            ui.heading("Scene");
+            let rows = std::mem::take(&mut self.rows.1);
+            let reveal = match self.doc.selection {
+                Some(Selection::Node(id)) if self.doc.selection != self.tree_seen => Some(id),
+                _ => None,
+            };
+            edits.extend(tree::ui(ui, &mut self.doc, &rows, reveal));
+            self.tree_seen = self.doc.selection;
+            self.rows.1 = rows;
+        });
+        self.layout.shown_tree(tree.response.rect.width());
+        let left = ui.available_rect_before_wrap().width();
+        let epoch = self.widget_epoch;
+        let inspector = self.layout.inspector_panel(left).show(ui, |ui| {
+            ui.heading("Inspector");
+            ui.push_id(("document", epoch), |ui| edits.extend(inspector::ui(ui, &mut self.doc)));
+        });
+        self.layout.shown_inspector(inspector.response.rect.width());
+        if self.pixel_inspector_open {
+            // Docked under the view, between the side panels: it covers neither the tree nor
+            // the image, and the next click in the view is free.
+            let height = ui.available_rect_before_wrap().height();
+            self.layout.dock_panel(height).show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.strong("Pixel inspector");
+                    if ui.small_button("Close").clicked() {
+                        self.pixel_inspector_open = false;
+                    }
+                });
+                egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| match &self.story {
+                    Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
+                    None => {
+                        ui.label("Click a pixel in the render view.");
+                    }
+                });
             });
-        egui::Panel::right("inspector")
-            .resizable(true)
-            .default_size(300.0)
-            .show(ui, |ui| {
-                ui.heading("Inspector");
-                edits.extend(inspector::ui(ui, &mut self.doc));
-            });
+        }
         let mut pick = None;
         let mut size = (1, 1);
         egui::CentralPanel::default().show(ui, |ui| {
@@ -605,6 +899,7 @@ impl TracelabApp {
         for e in edits {
             self.apply(e);
         }
+        self.panels_generation = self.doc.generation;
         if let Some(p) = pick {
             self.inspect(p.frame, p.x, p.row);
         }
@@ -612,7 +907,7 @@ impl TracelabApp {
         // Edits and dialogs above changed the document after the view asked for its render:
         // start the new one now, not on the next input event.
         self.request_render(size);
-        if !self.worker.is_idle() {
+        if !self.worker.is_idle() || self.loading.is_some() {
             ctx.request_repaint_after(Duration::from_millis(30));
         } else {
             // Keep watching the file on disk while idle.
@@ -648,6 +943,7 @@ impl eframe::App for TracelabApp {
                 self.view.depth.1
             ),
         );
+        storage.set_string("layout", self.layout.epoch.to_string());
     }
 }
 
@@ -669,6 +965,7 @@ pub fn run(scene: Option<PathBuf>) -> Result<(), String> {
                 AppOptions {
                     scene,
                     fixed_size: None,
+                    native_dialogs: true,
                 },
             )))
         }),

@@ -208,6 +208,10 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 }
                 kind => g.add(Node::new(kind)),
             };
+            // In the file, a Group's MaterialIndex holds for every object after it; give the
+            // new last object that material, so it renders now as it will after a save.
+            let sticky = g.node(parent).children.iter().rev().find_map(|&c| g.node(c).material);
+            g.node_mut(id).material = sticky;
             g.push_child(parent, id);
             return Ok(After::SelectNode(id));
         }

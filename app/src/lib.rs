@@ -4,6 +4,7 @@ pub mod app;
 pub mod cli;
 pub mod edit;
 pub mod io;
+pub mod loading;
 pub mod render_worker;
 pub mod state;
 pub mod ui;

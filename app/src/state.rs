@@ -205,17 +205,22 @@ impl Document {
         }
     }
 
-    /// Opens a file. A file that cannot be read at all leaves the current scene open and
-    /// reports why; per-node errors (a missing OBJ) open the scene and report them.
+    /// Opens a file now (blocking; the app reads files on a thread, see `crate::loading`).
+    /// A file that cannot be read at all leaves the current scene open and reports why;
+    /// per-node errors (a missing OBJ) open the scene and report them.
     pub fn open(&mut self, path: &Path) -> Result<(), String> {
-        let out = tracelab_core::load_scene(path, &mut self.mesh_cache);
-        let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
-        let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
-        match out.scene {
-            Some(scene) => {
-                let cache = std::mem::take(&mut self.mesh_cache);
+        let read = read_scene_file(path, std::mem::take(&mut self.mesh_cache));
+        self.install(read)
+    }
+
+    /// Replaces the document by a scene read with [`read_scene_file`], adopting its mesh
+    /// cache; a file that could not be read leaves the scene and reports why.
+    pub fn install(&mut self, read: SceneRead) -> Result<(), String> {
+        let SceneRead { path, outcome, cache } = read;
+        match outcome {
+            Ok(Opened { scene, messages, lost_comments }) => {
                 let generation = self.generation + 1;
-                *self = Document::new(scene, Some(path.to_path_buf()));
+                *self = Document::new(scene, Some(path));
                 self.mesh_cache = cache;
                 self.messages = messages;
                 self.lost_comments = lost_comments;
@@ -223,7 +228,8 @@ impl Document {
                 self.generation = generation;
                 Ok(())
             }
-            None => {
+            Err(messages) => {
+                self.mesh_cache = cache;
                 let text = messages.join("\n");
                 self.messages = messages;
                 Err(text)
@@ -262,6 +268,8 @@ impl Document {
             tracelab_core::rebase_mesh_paths(&mut s.scene, &from, &to);
         }
         self.path = Some(path.to_path_buf());
+        // Those comments are gone from the file now; the next save has none to lose.
+        self.lost_comments.clear();
         self.saved_state_id = self.state_id;
         self.disk_stamp = modified(path);
         Ok(())
@@ -281,6 +289,37 @@ impl Document {
             _ => false,
         }
     }
+}
+
+/// A scene file as read, before it replaces the document: on any thread, so that a large
+/// mesh cannot freeze the window, and before asking about unsaved changes, so that nothing
+/// is asked when the file cannot be opened.
+pub struct SceneRead {
+    pub path: PathBuf,
+    /// The scene, or the errors that kept it from opening.
+    pub outcome: Result<Opened, Vec<String>>,
+    /// The mesh cache the read used (a copy of the document's plus what it loaded).
+    pub cache: MeshCache,
+}
+
+pub struct Opened {
+    pub scene: Scene,
+    /// Warnings and per-node errors, `file:line:col: message`.
+    pub messages: Vec<String>,
+    /// Comments that saving would drop (see [`Document::save_warnings`]).
+    pub lost_comments: Vec<String>,
+}
+
+/// Reads and parses a scene file with its meshes.
+pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
+    let out = tracelab_core::load_scene(path, &mut cache);
+    let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
+    let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
+    let outcome = match out.scene {
+        Some(scene) => Ok(Opened { scene, messages, lost_comments }),
+        None => Err(messages),
+    };
+    SceneRead { path: path.to_path_buf(), outcome, cache }
 }
 
 fn folder_of(file: &Path) -> PathBuf {

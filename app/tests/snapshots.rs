@@ -34,6 +34,7 @@ fn settled_harness() -> Harness<'static, TracelabApp> {
                 AppOptions {
                     scene: None,
                     fixed_size: Some((320, 240)),
+                    ..AppOptions::default()
                 },
             );
             app.show_timings = false;

@@ -11,16 +11,39 @@ pub enum Purpose {
     Export,
 }
 
+impl Purpose {
+    /// The extensions the listing shows (folders are always shown).
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Purpose::Open | Purpose::SaveAs => &["txt"],
+            Purpose::Export => &["png", "tga"],
+        }
+    }
+
+    /// What the filter is called, e.g. "Scene files (*.txt)".
+    pub fn filter_name(self) -> &'static str {
+        match self {
+            Purpose::Open | Purpose::SaveAs => "Scene files (*.txt)",
+            Purpose::Export => "Images (*.png, *.tga)",
+        }
+    }
+}
+
 pub struct FileDialog {
     pub purpose: Purpose,
     dir: PathBuf,
     name: String,
     entries: Vec<(String, bool)>,
     error: Option<String>,
+    /// List every file, not only those the filter names.
+    all_files: bool,
 }
 
 impl FileDialog {
     pub fn new(purpose: Purpose, start: Option<&Path>) -> Self {
+        // Absolute, so a file opened as "scene.txt" shows its folder, not ".".
+        let start = start.map(|p| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()));
+        let start = start.as_deref();
         let (dir, name) = match start {
             Some(p) if p.is_dir() => (p.to_path_buf(), String::new()),
             Some(p) => (
@@ -36,6 +59,7 @@ impl FileDialog {
                 String::new(),
             ),
         };
+        let dir = std::path::absolute(&dir).unwrap_or(dir);
         let name = match purpose {
             Purpose::Export => Path::new(&name)
                 .with_extension("png")
@@ -49,6 +73,7 @@ impl FileDialog {
             name,
             entries: Vec::new(),
             error: None,
+            all_files: false,
         };
         d.refresh();
         d
@@ -72,6 +97,36 @@ impl FileDialog {
             }
             Err(e) => self.error = Some(format!("{}: {e}", self.dir.display())),
         }
+    }
+
+    /// Whether the listing shows `name` (a file; folders always show).
+    fn listed(&self, name: &str) -> bool {
+        self.all_files
+            || Path::new(name)
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| self.purpose.extensions().iter().any(|x| e.eq_ignore_ascii_case(x)))
+    }
+
+    /// The folder shown.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// What the dialog gives for the name typed: a folder is entered, not returned.
+    fn choose(&mut self) -> Option<PathBuf> {
+        if self.name.is_empty() {
+            return None;
+        }
+        // A typed absolute path wins over the folder shown.
+        let p = self.dir.join(&self.name);
+        if p.is_dir() {
+            self.dir = std::path::absolute(&p).unwrap_or(p);
+            self.name.clear();
+            self.refresh();
+            return None;
+        }
+        Some(p)
     }
 
     /// Shows the dialog; returns `Some(Some(path))` when chosen, `Some(None)` when cancelled.
@@ -103,6 +158,9 @@ impl FileDialog {
                     .show(ui, |ui| {
                         let mut go = None;
                         for (name, is_dir) in &self.entries {
+                            if !is_dir && !self.listed(name) {
+                                continue;
+                            }
                             let label = if *is_dir {
                                 format!("{name}/")
                             } else {
@@ -125,21 +183,27 @@ impl FileDialog {
                             self.refresh();
                         }
                     });
+                let mut enter = false;
                 ui.horizontal(|ui| {
                     ui.label("File name");
-                    ui.text_edit_singleline(&mut self.name);
+                    let r = ui.text_edit_singleline(&mut self.name);
+                    // A single-line field gives up focus on Enter: that is the confirm key.
+                    enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
                 });
+                ui.checkbox(&mut self.all_files, "All files")
+                    .on_hover_text(format!("Off: {} and folders only", self.purpose.filter_name()));
                 ui.horizontal(|ui| {
                     let ok = match self.purpose {
                         Purpose::Open => "Open",
                         _ => "Save",
                     };
-                    if ui
+                    let clicked = ui
                         .add_enabled(!self.name.is_empty(), egui::Button::new(ok))
-                        .clicked()
+                        .clicked();
+                    if (clicked || enter)
+                        && let Some(p) = self.choose()
                     {
-                        // A typed absolute path wins over the folder shown.
-                        result = Some(Some(self.dir.join(&self.name)));
+                        result = Some(Some(p));
                     }
                     if ui.button("Cancel").clicked() {
                         result = Some(None);

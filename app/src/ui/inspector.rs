@@ -7,6 +7,7 @@ use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId
 
 use crate::edit::Edit;
 use crate::state::{Document, Selection};
+use crate::ui::drag_speed::{DragSpeeds, world_per_unit};
 
 pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
     let mut edits = Vec::new();
@@ -107,6 +108,7 @@ fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
 }
 
 fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
+    let speeds = DragSpeeds::for_scene_camera(cam);
     ui.heading("Camera");
     let mut c = cam.clone();
     let mut changed = false;
@@ -138,10 +140,10 @@ fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
             up,
             size,
         } => {
-            changed |= vec3(ui, "center", center, 0.02);
+            changed |= vec3(ui, "center", center, speeds.length(1.0));
             changed |= vec3(ui, "direction", direction, 0.01);
             changed |= vec3(ui, "up", up, 0.01);
-            changed |= scalar(ui, "size", size, 0.02);
+            changed |= scalar(ui, "size", size, DragSpeeds::factor(*size));
         }
         Camera::Perspective {
             center,
@@ -149,7 +151,7 @@ fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
             up,
             angle,
         } => {
-            changed |= vec3(ui, "center", center, 0.02);
+            changed |= vec3(ui, "center", center, speeds.length(1.0));
             changed |= vec3(ui, "direction", direction, 0.01);
             changed |= vec3(ui, "up", up, 0.01);
             changed |= scalar(ui, "angle (degrees)", angle, 0.1);
@@ -234,7 +236,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
             .filter_map(|&p| g.get(p))
             .map(|n| n.kind.name())
             .collect();
-        ui.small(names.join(" › "));
+        ui.small(breadcrumb(&names));
     }
     // MaterialIndex
     if id != g.root() {
@@ -246,13 +248,13 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         egui::ComboBox::from_label("material")
             .selected_text(match current {
                 Some(_) => text(current),
-                None => format!(
-                    "inherit ({})",
-                    eff.map_or("default".into(), |m| format!("Material {m}"))
-                ),
+                // Name what it renders with, not only that it inherits.
+                None => eff.map_or("inherits no material: default grey".into(), |m| {
+                    format!("inherits Material {m}")
+                }),
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut chosen, None, "inherit");
+                ui.selectable_value(&mut chosen, None, "inherit from the Group");
                 for m in 0..mats {
                     ui.selectable_value(&mut chosen, Some(m), text(Some(m)));
                 }
@@ -265,15 +267,23 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         }
     }
     ui.separator();
+    // Lengths drag by a share of the view, in the units of the space the node lives in.
+    let speeds = DragSpeeds::for_scene(&doc.scene);
+    let len = speeds.length(world_per_unit(&doc.scene, id, None));
     let mut kind = n.kind.clone();
     match &mut kind {
-        NodeKind::Transform(ops) => transform_ops(ui, id, ops, edits),
+        NodeKind::Transform(ops) => {
+            let lens: Vec<f64> = (0..ops.len())
+                .map(|i| speeds.length(world_per_unit(&doc.scene, id, Some(i))))
+                .collect();
+            transform_ops(ui, id, ops, &lens, edits);
+        }
         NodeKind::Group => {
             ui.label(format!("{} objects", n.children.len()));
         }
         NodeKind::Sphere { center, radius } => {
-            let mut c = vec3(ui, "center", center, 0.02);
-            c |= scalar(ui, "radius", radius, 0.01);
+            let mut c = vec3(ui, "center", center, len);
+            c |= scalar(ui, "radius", radius, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -283,7 +293,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         }
         NodeKind::Plane { normal, offset } => {
             let mut c = vec3(ui, "normal", normal, 0.01);
-            c |= scalar(ui, "offset", offset, 0.02);
+            c |= scalar(ui, "offset", offset, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -294,7 +304,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         NodeKind::Triangle { vertices } => {
             let mut c = false;
             for (i, v) in vertices.iter_mut().enumerate() {
-                c |= vec3(ui, &format!("vertex{i}"), v, 0.02);
+                c |= vec3(ui, &format!("vertex{i}"), v, len);
             }
             if c {
                 edits.push(Edit::SetNodeKind {
@@ -305,7 +315,9 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
         }
         NodeKind::TriangleMesh { obj_file, mesh } => {
             // The path being typed lives in egui's memory until it is loaded: an edit per
-            // keystroke would fill the undo history with half-typed names.
+            // keystroke would fill the undo history with half-typed names. The app salts the
+            // inspector's ids with its widget epoch, so after an open, undo or reload the
+            // field starts again from the document's value.
             let buf_id = ui.scope_id().with(("obj_file", id.0));
             let mut path = ui
                 .data_mut(|d| d.get_temp::<String>(buf_id))
@@ -314,7 +326,15 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
                 ui.label("obj_file");
                 ui.text_edit_singleline(&mut path);
             });
-            ui.data_mut(|d| d.insert_temp(buf_id, path.clone()));
+            if path == *obj_file {
+                ui.data_mut(|d| d.remove::<String>(buf_id));
+            } else {
+                ui.data_mut(|d| d.insert_temp(buf_id, path.clone()));
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    format!("not loaded yet (the scene uses {obj_file:?}): press Enter or Load / reload"),
+                );
+            }
             match mesh {
                 MeshSlot::Loaded(m) => {
                     ui.label(format!(
@@ -352,8 +372,8 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
             }
         }
         NodeKind::Box { min, max } => {
-            let mut c = vec3(ui, "min", min, 0.02);
-            c |= vec3(ui, "max", max, 0.02);
+            let mut c = vec3(ui, "min", min, len);
+            c |= vec3(ui, "max", max, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -410,16 +430,18 @@ fn op_names() -> [(&'static str, TransformOp); 8] {
     ]
 }
 
-fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], edits: &mut Vec<Edit>) {
+/// `lengths[i]`: the drag speed of a length in the space op `i` acts in.
+fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengths: &[f64], edits: &mut Vec<Edit>) {
     ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
     let n = ops.len();
     for (index, op) in ops.iter_mut().enumerate() {
         ui.push_id(index, |ui| {
             ui.group(|ui| {
+                let len = lengths.get(index).copied().unwrap_or(0.02);
                 let changed = match op {
-                    TransformOp::Translate(v) => vec3(ui, "Translate", v, 0.02),
-                    TransformOp::Scale(v) => vec3(ui, "Scale", v, 0.01),
-                    TransformOp::UniformScale(s) => scalar(ui, "UniformScale", s, 0.01),
+                    TransformOp::Translate(v) => vec3(ui, "Translate", v, len),
+                    TransformOp::Scale(v) => vec3(ui, "Scale", v, DragSpeeds::factor(v.abs().max_element())),
+                    TransformOp::UniformScale(s) => scalar(ui, "UniformScale", s, DragSpeeds::factor(*s)),
                     TransformOp::XRotate(d) => scalar(ui, "XRotate (degrees)", d, 0.5),
                     TransformOp::YRotate(d) => scalar(ui, "YRotate (degrees)", d, 0.5),
                     TransformOp::ZRotate(d) => scalar(ui, "ZRotate (degrees)", d, 0.5),
@@ -495,4 +517,33 @@ fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
         *m = Mat4::from_cols_array_2d(&rows).transpose();
     }
     changed
+}
+
+/// The path from the root to the selection, "Group › Transform › Sphere"; a deep one keeps
+/// its two first and four last steps (20,000 nested Groups once filled the inspector).
+fn breadcrumb(names: &[&str]) -> String {
+    const HEAD: usize = 2;
+    const TAIL: usize = 4;
+    if names.len() <= HEAD + TAIL + 1 {
+        return names.join(" › ");
+    }
+    let hidden = names.len() - HEAD - TAIL;
+    format!(
+        "{} › … {hidden} more … › {}",
+        names[..HEAD].join(" › "),
+        names[names.len() - TAIL..].join(" › ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::breadcrumb;
+
+    #[test]
+    fn a_deep_breadcrumb_keeps_its_ends_and_counts_the_middle() {
+        assert_eq!(breadcrumb(&["Group", "Transform", "Sphere"]), "Group › Transform › Sphere");
+        let deep: Vec<&str> = std::iter::repeat_n("Group", 20_000).chain(["Sphere"]).collect();
+        let b = breadcrumb(&deep);
+        assert_eq!(b, "Group › Group › … 19995 more … › Group › Group › Group › Sphere");
+    }
 }

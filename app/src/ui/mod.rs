@@ -1,7 +1,11 @@
 //! The panels. Each reads the document and returns edits; `app.rs` applies them.
 
+pub mod drag_speed;
 pub mod file_dialog;
 pub mod inspector;
+pub mod layout;
+pub mod loading;
+pub mod native_dialog;
 pub mod pixel_inspector;
 pub mod status;
 pub mod tree;

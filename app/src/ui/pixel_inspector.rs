@@ -1,8 +1,55 @@
-//! The pixel inspector: the story of one pixel's ray, from the core's `inspect_pixel`.
+//! The pixel inspector: the story of one pixel's ray, from the core's `inspect_pixel`. The
+//! pixel stays chosen while the scene and the view change: each new render traces it again,
+//! so the story always describes the image on screen (it once kept showing a deleted box).
+
+use std::sync::Arc;
 
 use glam::Vec3;
-use tracelab_core::render::RayStory;
-use tracelab_core::{NodeKind, NormalTransform, Scene};
+use tracelab_core::render::{RayStory, inspect_pixel};
+use tracelab_core::{NodeKind, NormalTransform, RenderSettings, Scene};
+
+use crate::render_worker::Published;
+
+/// The pixel being inspected, and the render its story was traced in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Inspected {
+    /// Which image: 0, or 1 for the Incorrect rule in compare mode.
+    pub frame: usize,
+    pub x: u32,
+    pub row: u32,
+    /// The image size the pixel was picked in, to find the same place after a resize.
+    pub size: (u32, u32),
+    /// The render request the story belongs to.
+    pub request: u64,
+}
+
+/// Traces pixel (`x`, `row`) of image `frame` of a published render.
+pub fn trace(p: &Published, frame: usize, x: u32, row: u32) -> Option<(Inspected, RayStory, Arc<Scene>)> {
+    let mode = *p.job.modes.get(frame)?;
+    let settings = RenderSettings { normal_transform: mode, ..p.job.settings };
+    let at = Inspected {
+        frame,
+        x: x.min(settings.width.saturating_sub(1)),
+        row: row.min(settings.height.saturating_sub(1)),
+        size: (settings.width, settings.height),
+        request: p.job.request,
+    };
+    let story = inspect_pixel(&p.job.scene, &p.compiled, &settings, at.x, at.row);
+    Some((at, story, p.job.scene.clone()))
+}
+
+/// The same pixel traced in a newer render: the same place in the image when its size
+/// changed, and the first image when the one it was in is gone (compare mode turned off).
+/// `None` when `p` is the render `at` was traced in.
+pub fn follow(p: &Published, at: &Inspected) -> Option<(Inspected, RayStory, Arc<Scene>)> {
+    if p.job.request == at.request {
+        return None;
+    }
+    let (w, h) = (p.job.settings.width, p.job.settings.height);
+    let scale = |v: u32, old: u32, new: u32| ((f64::from(v) + 0.5) * f64::from(new) / f64::from(old.max(1))) as u32;
+    let frame = if at.frame < p.job.modes.len() { at.frame } else { 0 };
+    trace(p, frame, scale(at.x, at.size.0, w), scale(at.row, at.size.1, h))
+}
 
 fn v(v: Vec3) -> String {
     format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)

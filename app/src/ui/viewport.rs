@@ -2,6 +2,7 @@
 //! range and size controls, the images themselves (uploaded as textures when the worker has
 //! new pixels), and picking.
 
+use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size};
 use tracelab_core::{NormalTransform, RenderSettings, View};
 
 use crate::render_worker::{Published, RenderWorker};
@@ -207,9 +208,25 @@ impl Viewport {
             if ui.checkbox(&mut fixed, "fixed size").changed() {
                 s.fixed_size = fixed.then_some((200, 200));
             }
-            if let Some((w, h)) = &mut s.fixed_size {
-                ui.add(egui::DragValue::new(w).range(1..=4096).suffix(" w"));
-                ui.add(egui::DragValue::new(h).range(1..=4096).suffix(" h"));
+            let error_id = ui.make_persistent_id("fixed-size-refused");
+            if let Some(size) = &mut s.fixed_size {
+                let before = *size;
+                // Whole numbers only: "nan" once parsed, was clamped and became 4096.
+                let parse = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+                let side = 1..=MAX_IMAGE_SIDE;
+                ui.add(egui::DragValue::new(&mut size.0).range(side.clone()).custom_parser(parse).suffix(" w"));
+                ui.add(egui::DragValue::new(&mut size.1).range(side).custom_parser(parse).suffix(" h"));
+                if *size != before {
+                    // The same limits as the command line: refuse, keep the last good size, say why.
+                    let refused = check_image_size(size.0, size.1).err().map(|e| e.to_string());
+                    if refused.is_some() {
+                        *size = before;
+                    }
+                    ui.data_mut(|d| d.insert_temp(error_id, refused));
+                }
+                if let Some(e) = ui.data(|d| d.get_temp::<Option<String>>(error_id)).flatten() {
+                    ui.colored_label(ui.visuals().error_fg_color, e);
+                }
             }
         });
     }

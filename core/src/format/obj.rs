@@ -48,14 +48,48 @@ pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, 
 }
 
 /// Meshes already loaded, by canonical path; reused while the file is unchanged on disk.
-#[derive(Default)]
+/// Cloning is cheap (the meshes are shared), so a load on another thread can start from a
+/// copy while the original stays in use.
+#[derive(Clone, Default)]
 pub struct MeshCache {
     meshes: HashMap<PathBuf, (Option<SystemTime>, u64, Arc<Mesh>)>,
+    observer: Option<MeshObserver>,
+}
+
+/// Told before each step of reading an OBJ file from disk (meshes served from the cache are
+/// not reported), for a progress display. Returning `false` stops that load: it fails with
+/// [`MESH_LOAD_CANCELLED`], and so does every later one, at once.
+pub type MeshObserver = Arc<dyn Fn(MeshEvent<'_>) -> bool + Send + Sync>;
+
+/// The message of a mesh load stopped by its observer.
+pub const MESH_LOAD_CANCELLED: &str = "loading cancelled";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshEvent<'a> {
+    /// About to read `path`, `bytes` long.
+    Reading { path: &'a Path, bytes: u64 },
+    /// Read; about to parse its text.
+    Parsing { path: &'a Path },
+    /// Parsed; about to build the BVH over `triangles` triangles (the longest step).
+    Building { path: &'a Path, triangles: usize },
+    /// Done with `path`, loaded or failed.
+    Done { path: &'a Path },
+}
+
+impl std::fmt::Debug for MeshCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MeshCache").field("meshes", &self.meshes.len()).field("observed", &self.observer.is_some()).finish()
+    }
 }
 
 impl MeshCache {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Reports each step of each mesh read from disk to `observer` (see [`MeshObserver`]).
+    pub fn set_observer(&mut self, observer: Option<MeshObserver>) {
+        self.observer = observer;
     }
 
     pub fn load(&mut self, path: &Path) -> Result<Arc<Mesh>, String> {
@@ -67,7 +101,25 @@ impl MeshCache {
         {
             return Ok(m.clone());
         }
-        let mesh = Arc::new(load_obj(&canon)?);
+        let observer = self.observer.clone();
+        let go_on = |e: MeshEvent<'_>| observer.as_ref().is_none_or(|o| o(e));
+        let loaded = (|| {
+            if !go_on(MeshEvent::Reading { path: &canon, bytes: meta.len() }) {
+                return Err(MESH_LOAD_CANCELLED.to_string());
+            }
+            let bytes = read_obj_bytes(&canon)?;
+            if !go_on(MeshEvent::Parsing { path: &canon }) {
+                return Err(MESH_LOAD_CANCELLED.to_string());
+            }
+            let (positions, triangles) = parse_obj_triangles(&bytes, &file_name(&canon))?;
+            drop(bytes);
+            if !go_on(MeshEvent::Building { path: &canon, triangles: triangles.len() }) {
+                return Err(MESH_LOAD_CANCELLED.to_string());
+            }
+            Ok(Mesh::new(positions, triangles))
+        })();
+        go_on(MeshEvent::Done { path: &canon });
+        let mesh = Arc::new(loaded?);
         self.meshes.insert(canon, (stamp.0, stamp.1, mesh.clone()));
         Ok(mesh)
     }
@@ -79,9 +131,19 @@ impl MeshCache {
     }
 }
 
+fn file_name(path: &Path) -> String {
+    path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default()
+}
+
 /// Reads one OBJ file into a single mesh (all its objects and groups together). Only regular
 /// files are read (a FIFO is never opened), at most `MAX_OBJ_BYTES` of them.
 pub fn load_obj(path: &Path) -> Result<Mesh, String> {
+    let bytes = read_obj_bytes(path)?;
+    parse_obj(&bytes, &file_name(path))
+}
+
+/// The bytes of an OBJ file: a regular file only, at most `MAX_OBJ_BYTES`.
+fn read_obj_bytes(path: &Path) -> Result<Vec<u8>, String> {
     use std::io::Read as _;
     let file = open_regular(path)?;
     let mut bytes = Vec::new();
@@ -89,13 +151,18 @@ pub fn load_obj(path: &Path) -> Result<Mesh, String> {
     if bytes.len() > MAX_OBJ_BYTES {
         return Err(format!("the file is larger than {} MiB, the most tracelab reads as an OBJ mesh", MAX_OBJ_BYTES >> 20));
     }
-    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-    parse_obj(&bytes, &name)
+    Ok(bytes)
 }
 
 /// Parses OBJ text (`name` is used in messages): the fast reader when it understands the
 /// file, else tobj.
 pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, String> {
+    let (positions, triangles) = parse_obj_triangles(bytes, name)?;
+    Ok(Mesh::new(positions, triangles))
+}
+
+/// Positions and triangles of OBJ text, checked, before the BVH is built.
+fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
     let (positions, triangles) = match fast::parse(bytes) {
         Some(r) => r,
         None => load_with_tobj(bytes, name)?,
@@ -103,7 +170,7 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, String> {
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
         return Err(format!("vertex {} is not finite", i + 1));
     }
-    Ok(Mesh::new(positions, triangles))
+    Ok((positions, triangles))
 }
 
 /// Positions and triangles as the fast reader gives them, or None when it defers to tobj.
@@ -219,6 +286,40 @@ mod tests {
         );
         let m = load_obj(&p).expect("load");
         assert_eq!(m.triangle_count(), 2);
+    }
+
+    #[test]
+    fn the_cache_reports_each_step_and_an_observer_can_stop_a_load() {
+        use std::sync::Mutex;
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+        let p = write("steps.obj", text);
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let stop_at_build = Arc::new(std::sync::atomic::AtomicBool::new(true));
+        let (s, stop) = (seen.clone(), stop_at_build.clone());
+        let mut cache = MeshCache::new();
+        cache.set_observer(Some(Arc::new(move |e: MeshEvent<'_>| {
+            let step = match e {
+                MeshEvent::Reading { bytes, .. } => format!("reading {bytes}"),
+                MeshEvent::Parsing { .. } => "parsing".into(),
+                MeshEvent::Building { triangles, .. } => format!("building {triangles}"),
+                MeshEvent::Done { .. } => "done".into(),
+            };
+            s.lock().expect("lock").push(step);
+            !(stop.load(std::sync::atomic::Ordering::Relaxed) && matches!(e, MeshEvent::Building { .. }))
+        })));
+        assert_eq!(cache.load(&p).expect_err("stopped"), MESH_LOAD_CANCELLED);
+        let reading = format!("reading {}", text.len());
+        assert_eq!(*seen.lock().expect("lock"), [reading.as_str(), "parsing", "building 2", "done"]);
+        // A stopped load caches nothing: the next one reads the file again.
+        stop_at_build.store(false, std::sync::atomic::Ordering::Relaxed);
+        seen.lock().expect("lock").clear();
+        assert_eq!(cache.load(&p).expect("loads").triangle_count(), 2);
+        assert_eq!(seen.lock().expect("lock").len(), 4);
+        // From the cache: nothing to report.
+        seen.lock().expect("lock").clear();
+        let copy = cache.clone();
+        assert!(copy.clone().load(&p).is_ok());
+        assert!(seen.lock().expect("lock").is_empty());
     }
 
     #[test]
