@@ -788,7 +788,8 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
         h.step();
         std::thread::sleep(Duration::from_millis(20));
     }
-    assert_eq!(h.state().doc.scene, before, "a cancelled load replaced the scene");
+    // Not assert_eq: the Debug of an 871k-triangle scene is hundreds of MB.
+    assert!(h.state().doc.scene == before, "a cancelled load replaced the scene");
     assert!(h.query_by_label_contains("Opening dragon.txt").is_none());
     // Opened for real: frames keep coming while it loads.
     h.state_mut().open(&dragon);
