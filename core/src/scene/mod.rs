@@ -6,11 +6,13 @@ mod comments;
 mod graph;
 mod mesh;
 mod transform;
+pub mod validate;
 
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, check_closed};
 pub use transform::{TransformOp, compose};
+pub use validate::{Invalid, Place, Problem, check_scene, unit};
 
 use glam::Vec3;
 

@@ -28,7 +28,7 @@ impl TransformOp {
             TransformOp::Rotate { axis, degrees } => {
                 // A deliberate difference from the course parser: the axis is normalised, so
                 // `Rotate { 0 0 2 90 }` is a rotation, not a rotation and a scale.
-                let axis = axis.try_normalize().unwrap_or(Vec3::Z);
+                let axis = super::validate::unit(axis).unwrap_or(Vec3::Z);
                 Mat4::from_axis_angle(axis, degrees.to_radians())
             }
             TransformOp::Matrix(m) => m,
@@ -66,9 +66,10 @@ impl TransformOp {
 
 /// M = op1 · op2 · … · opn: the first op listed is applied last, as nested Transforms would.
 /// (Another deliberate difference from the course code: `Matrix` composes in its listed
-/// position like every other op.)
+/// position like every other op.) Composed in f64 and rounded once, so long chains keep
+/// their precision.
 pub fn compose(ops: &[TransformOp]) -> Mat4 {
-    ops.iter().fold(Mat4::IDENTITY, |m, op| m * op.matrix())
+    super::validate::compose_f64(ops).as_mat4()
 }
 
 #[cfg(test)]
