@@ -54,6 +54,8 @@ pub struct Problem {
     pub op: Option<usize>,
     /// Names the place: `Sphere (node #4): radius must be positive, found -1`.
     pub message: String,
+    /// The rule alone, to show beside the field: `Sphere: radius must be positive, found -1`.
+    pub reason: String,
     pub incomplete: bool,
 }
 
@@ -419,12 +421,18 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
     while let Some((id, parent)) = stack.pop() {
         let Some(node) = graph.get(id) else { continue };
         let name = node.kind.name();
-        let mut push = |field: &str, op: Option<usize>, message: String, incomplete: bool| {
+        let mut push = |field: &str, op: Option<usize>, reason: String, incomplete: bool| {
+            // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
+            let rest = reason
+                .strip_prefix(name)
+                .and_then(|r| r.strip_prefix(": "))
+                .unwrap_or(&reason);
             out.push(Problem {
                 place: Place::Node(id),
                 field: field.to_string(),
                 op,
-                message: format!("{name} (node #{}): {message}", id.0),
+                message: format!("{name} (node #{}): {rest}", id.0),
+                reason: reason.clone(),
                 incomplete,
             })
         };
@@ -507,6 +515,7 @@ pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
                     place: Place::Node(id),
                     field: "ops".into(),
                     op: None,
+                    reason: message.clone(),
                     message,
                     incomplete: false,
                 });
@@ -525,11 +534,13 @@ pub fn check_scene(scene: &Scene) -> Vec<Problem> {
     let mut out = Vec::new();
     let mut push = |r: Result<(), Invalid>, place: Place, what: String| {
         if let Err(e) = r {
+            let message = format!("{what}: {}", e.message);
             out.push(Problem {
                 place,
                 field: e.field,
                 op: None,
-                message: format!("{what}: {}", e.message),
+                message,
+                reason: e.message,
                 incomplete: false,
             });
         }
