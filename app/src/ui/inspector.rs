@@ -139,7 +139,8 @@ fn same_field(label: &str, field: &str) -> bool {
 fn refusal_note(ui: &mut egui::Ui, label: &str) {
     let (note, op) = ui.data(|d| (d.get_temp::<Option<Note>>(note_id()).flatten(), d.get_temp::<Option<usize>>(op_id()).flatten()));
     if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
-        ui.colored_label(ui.visuals().error_fg_color, n.reason);
+        // Wrapped in what is left of the row: a long reason must not widen the panel.
+        ui.add(egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color)).wrap());
     }
 }
 

@@ -91,12 +91,15 @@ pub fn unit(v: Vec3) -> Option<Vec3> {
 const MAX_CONDITION: f64 = 1e6;
 
 fn finite(name: &str, values: &[f32]) -> Result<(), Invalid> {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(Invalid::new(
+    // No value in the message: a number field turns a typed "nan" into +inf, and showing
+    // "inf" to someone who typed "nan" would only puzzle them.
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Invalid::new(
             name,
-            format!("{name} must be a finite number, not {v}"),
-        )),
-        None => Ok(()),
+            format!("{name} must be a finite number"),
+        ))
     }
 }
 
