@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 use tracelab_core::{
-    Background, Camera, Light, Material, Node, NodeId, NodeKind, Scene, TransformOp,
+    Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene, TransformOp,
+    check_scene,
 };
 
 #[derive(Clone, Debug, PartialEq)]
@@ -32,7 +33,8 @@ pub enum Edit {
         node: NodeId,
         kind: NodeKind,
     },
-    /// The `MaterialIndex` in effect from this node on (`None`: inherit).
+    /// The `MaterialIndex` in effect from this node on (`None`: none of its own, so it
+    /// continues the one before it in its list, or inherits its Group's).
     SetNodeMaterial {
         node: NodeId,
         material: Option<u32>,
@@ -111,6 +113,51 @@ impl Edit {
     }
 }
 
+/// Why an edit was refused: the place and field it would have broken, as the file names
+/// them (`radius`, `direction`, `Scale`), so the inspector can show the reason beside that
+/// field, and the reason itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Refusal {
+    /// `None` for an edit that does not fit the scene's structure (a stale id, a move into
+    /// its own subtree).
+    pub place: Option<Place>,
+    pub field: String,
+    /// For a Transform: the op at fault.
+    pub op: Option<usize>,
+    pub reason: String,
+}
+
+impl Refusal {
+    fn structural(reason: String) -> Self {
+        Refusal { place: None, field: String::new(), op: None, reason }
+    }
+
+    fn broken(p: &Problem) -> Self {
+        Refusal { place: Some(p.place), field: p.field.clone(), op: p.op, reason: p.reason.clone() }
+    }
+}
+
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.reason)
+    }
+}
+
+/// Applies an edit to a copy of `scene` and holds the result to the core's validity rules
+/// (the ones the parser and the checked writer apply): an edit that breaks one is refused,
+/// and `scene` stays as it was. Leaving a node incomplete (a new TriangleMesh with no file
+/// yet) is allowed; those problems come back with the new scene. `known` are the problems
+/// `scene` already has, which an edit does not answer for.
+pub fn apply_checked(scene: &Scene, known: &[Problem], edit: Edit) -> Result<(Scene, After, Vec<Problem>), Refusal> {
+    let mut next = scene.clone();
+    let after = apply_to(&mut next, edit).map_err(Refusal::structural)?;
+    let problems = check_scene(&next);
+    if let Some(p) = problems.iter().find(|p| !p.incomplete && !known.contains(p)) {
+        return Err(Refusal::broken(p));
+    }
+    Ok((next, after, problems))
+}
+
 /// What an applied edit wants selected afterwards.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum After {
@@ -123,10 +170,27 @@ pub enum After {
 /// id, an index out of range, a move into its own subtree) is an error and changes nothing.
 pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
     let g = &mut scene.graph;
+    // What every node rendered with, for edits that must keep their neighbours' colours.
+    let before = g.effective_materials();
     let parents = g.parents();
     let parent_of = |id: NodeId| parents.get(id.index()).copied().flatten();
     let root = g.root();
     let reachable = |id: NodeId| id == root || parent_of(id).is_some();
+    // A stale id (a node deleted since the panel drew it) edits nothing: its arena slot is
+    // out of the scene, and a value stored there could not be checked or saved.
+    let target = match &edit {
+        Edit::SetTransformOp { node, .. }
+        | Edit::AddOp { node, .. }
+        | Edit::RemoveOp { node, .. }
+        | Edit::MoveOp { node, .. }
+        | Edit::SetNodeKind { node, .. }
+        | Edit::SetNodeMaterial { node, .. }
+        | Edit::SwapOperands { node } => Some(*node),
+        _ => None,
+    };
+    if target.is_some_and(|id| !reachable(id)) {
+        return Err("no such node in the scene".into());
+    }
     match edit {
         Edit::SetTransformOp { node, index, op } => {
             let slot = transform_ops(g, node)?.get_mut(index).ok_or("no such op")?;
@@ -174,6 +238,9 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 return Err("the root Group has no MaterialIndex".into());
             }
             g.get_mut(node).ok_or("no such node")?.material = material;
+            if let Some(list) = parent_of(node) {
+                keep_list_colours(g, list, &before, Some(node));
+            }
         }
         Edit::AddNode { parent, kind } => {
             if !reachable(parent) || !matches!(g.node(parent).kind, NodeKind::Group) {
@@ -221,23 +288,26 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
             if let Some(csg) = parent_of(node).filter(|&p| matches!(g.node(p).kind, NodeKind::Csg(_))) {
                 let other = *g.node(csg).children.iter().find(|&&c| c != node).ok_or("a CSG node needs two operands")?;
                 let slot_parent = parent_of(csg).ok_or("not in the scene")?;
-                let material = g.node(csg).material;
                 // The comments above the CSG node described the slot the survivor now fills.
-                let mut before = g.node(csg).comments.before.clone();
+                let mut comments = g.node(csg).comments.before.clone();
                 let o = g.node_mut(other);
-                o.material = o.material.or(material);
-                before.append(&mut o.comments.before);
-                o.comments.before = before;
+                comments.append(&mut o.comments.before);
+                o.comments.before = comments;
+                // It keeps the material it rendered with, which it may have continued from
+                // the other operand.
+                o.material = before.get(other.index()).copied().flatten();
                 for c in &mut g.node_mut(slot_parent).children {
                     if *c == csg {
                         *c = other;
                     }
                 }
+                settle_material(g, other, &before)?;
                 return Ok(After::SelectNode(other));
             }
             let slot = group_slot(node, root, &parent_of, g)?;
             let parent = parent_of(slot).ok_or("not in the scene")?;
             g.node_mut(parent).children.retain(|&c| c != slot);
+            keep_list_colours(g, parent, &before, None);
             return Ok(After::ClearSelection);
         }
         Edit::DuplicateNode { node } => {
@@ -280,6 +350,9 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
                 index
             };
             g.insert_child(new_parent, index, slot);
+            // Moved or left behind, objects look as they did.
+            keep_list_colours(g, old_parent, &before, None);
+            keep_list_colours(g, new_parent, &before, None);
             return Ok(After::SelectNode(node));
         }
         Edit::WrapInTransform { node } | Edit::WrapInGroup { node } => {
@@ -346,6 +419,51 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
         Edit::SetBackground(b) => scene.background = b,
     }
     Ok(After::Keep)
+}
+
+/// A MaterialIndex holds for the later objects of its list (see
+/// [`Graph::list_materials`]), so an edit in `list` can change what an object there that sets
+/// none continues. Spell out what it rendered with before (`before`: effective materials by
+/// node index), so the edit changes only what it meant to. (One that rendered with the
+/// default material cannot be spelt out: the file has no MaterialIndex for it.)
+fn keep_list_colours(g: &mut Graph, list: NodeId, before: &[Option<u32>], except: Option<NodeId>) {
+    if !matches!(g.get(list).map(|n| &n.kind), Some(NodeKind::Group | NodeKind::Csg(_))) {
+        return;
+    }
+    let now = g.effective_materials();
+    for c in g.node(list).children.clone() {
+        let was = before.get(c.index()).copied().flatten();
+        if Some(c) != except && g.node(c).material.is_none() && was.is_some() && now.get(c.index()).copied().flatten() != was {
+            g.node_mut(c).material = was;
+        }
+    }
+}
+
+/// `node`, just put in a new place, sets its own material; if that place is inside a
+/// Transform, where no MaterialIndex can stand, the material moves up to the Transform the
+/// chain hangs from, the one listed in a Group or CSG node, whose other objects keep theirs.
+fn settle_material(g: &mut Graph, node: NodeId, before: &[Option<u32>]) -> Result<(), String> {
+    let parents = g.parents();
+    let parent_of = |id: NodeId| parents.get(id.index()).copied().flatten();
+    let listed = |g: &Graph, id: NodeId| matches!(g.get(id).map(|n| &n.kind), Some(NodeKind::Group | NodeKind::Csg(_)));
+    let mut slot = node;
+    let list = loop {
+        let p = parent_of(slot).ok_or("not in the scene")?;
+        if listed(g, p) {
+            break p;
+        }
+        slot = p;
+    };
+    if slot == node {
+        keep_list_colours(g, list, before, Some(node));
+        return Ok(());
+    }
+    let want = g.node_mut(node).material.take();
+    if want.is_some() && g.effective_materials().get(node.index()).copied().flatten() != want {
+        g.node_mut(slot).material = want;
+        keep_list_colours(g, list, before, Some(slot));
+    }
+    Ok(())
 }
 
 fn transform_ops(
@@ -472,6 +590,26 @@ Group {
         apply_to(&mut s, Edit::RemoveOp { node: t, index: 0 }).expect("removes");
         let text = written(&s);
         assert!(!text.contains("second op") && text.contains("        # first op\n        Translate 1 0 0\n"), "{text}");
+    }
+
+    #[test]
+    fn deleting_or_moving_a_node_keeps_the_colour_its_list_neighbour_continued() {
+        let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }
+Materials { numMaterials 3 Material { diffuseColor 1 0 0 } Material { diffuseColor 0 1 0 } Material { diffuseColor 0 0 1 } }
+Group { numObjects 3 MaterialIndex 1 Sphere { center -2 0 0 radius 1 } MaterialIndex 2 Sphere { center 0 0 0 radius 1 } Sphere { center 2 0 0 radius 1 } }
+";
+        let mut s = tracelab_core::parse_scene(text.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new()).scene.expect("parses");
+        let [_, d, b] = s.graph.node(s.graph.root()).children[..] else { panic!("three spheres") };
+        // B sets none of its own: it continues D's Material 2.
+        apply_to(&mut s, Edit::SetNodeMaterial { node: b, material: None }).expect("applies");
+        assert_eq!(s.graph.effective_materials()[b.index()], Some(2));
+        let mut moved = s.clone();
+        apply_to(&mut s, Edit::DeleteNode { node: d }).expect("deletes");
+        assert_eq!(s.graph.effective_materials()[b.index()], Some(2), "B would have continued Material 1");
+        let root = moved.graph.root();
+        apply_to(&mut moved, Edit::MoveNode { node: d, new_parent: root, index: usize::MAX }).expect("moves");
+        let m = moved.graph.effective_materials();
+        assert_eq!((m[b.index()], m[d.index()]), (Some(2), Some(2)));
     }
 
     #[test]

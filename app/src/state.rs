@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use tracelab_core::{MeshCache, NodeId, Scene};
+use tracelab_core::{MeshCache, NodeId, Problem, Scene, check_scene};
 
-use crate::edit::{After, CoalesceKey, Edit, apply_to};
+use crate::edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Selection {
@@ -47,6 +47,12 @@ pub struct Document {
     saved_state_id: u64,
     /// The key of the last edit while a drag goes on, so the drag is one undo step.
     gesture: Option<CoalesceKey>,
+    /// The scene's broken rules ([`check_scene`]), kept current: edits may leave only
+    /// incomplete ones, which block saving.
+    problems: Vec<Problem>,
+    /// The last edit refused, for the inspector to show beside its field; cleared by the
+    /// next change.
+    pub refusal: Option<Refusal>,
 }
 
 /// Keeps memory bounded on large scenes; 200 steps is far more than anyone undoes.
@@ -55,7 +61,10 @@ const MAX_UNDO: usize = 200;
 impl Document {
     pub fn new(scene: Scene, path: Option<PathBuf>) -> Self {
         let disk_stamp = path.as_deref().and_then(modified);
+        let problems = check_scene(&scene);
         Document {
+            problems,
+            refusal: None,
             scene,
             path,
             selection: None,
@@ -110,15 +119,19 @@ impl Document {
         !self.redo.is_empty()
     }
 
-    /// Applies an edit, recording undo; edits of one drag coalesce into one step.
-    pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
+    /// Applies an edit, recording undo; edits of one drag coalesce into one step. An edit
+    /// that would break a validity rule is refused and changes nothing (the value being
+    /// typed keeps its last valid one); the refusal stays in `refusal` for the inspector.
+    pub fn apply(&mut self, edit: Edit) -> Result<(), Refusal> {
         let key = edit.coalesce_key();
         let merge = key.is_some() && key == self.gesture;
-        let before = (!merge).then(|| self.scene.clone());
-        match apply_to(&mut self.scene, edit) {
-            Ok(after) => {
-                if let Some(scene) = before {
-                    self.push_undo(scene);
+        match apply_checked(&self.scene, &self.problems, edit) {
+            Ok((scene, after, problems)) => {
+                let before = std::mem::replace(&mut self.scene, scene);
+                self.problems = problems;
+                self.refusal = None;
+                if !merge {
+                    self.push_undo(before);
                     self.state_id = self.next_state_id;
                     self.next_state_id += 1;
                 }
@@ -133,8 +146,17 @@ impl Document {
                 self.fix_selection();
                 Ok(())
             }
-            Err(e) => Err(e),
+            Err(refusal) => {
+                self.refusal = Some(refusal.clone());
+                Err(refusal)
+            }
         }
+    }
+
+    /// Nodes in a state an edit passes through but a file cannot hold (a TriangleMesh with
+    /// no file chosen yet), with what is missing. Saving waits until there are none.
+    pub fn incomplete(&self) -> impl Iterator<Item = &Problem> {
+        self.problems.iter().filter(|p| p.incomplete)
     }
 
     /// Ends the current drag: the next edit starts a new undo step.
@@ -181,6 +203,8 @@ impl Document {
     }
 
     fn after_history_move(&mut self) {
+        self.problems = check_scene(&self.scene);
+        self.refusal = None;
         self.gesture = None;
         self.generation += 1;
         self.fix_selection();
@@ -256,14 +280,18 @@ impl Document {
     /// Writes the scene atomically (temporary file + rename) and marks it saved. Relative
     /// mesh paths are rewritten for the new folder first, in the whole history, so they keep
     /// naming the same files from there (and after an undo).
+    ///
+    /// Nothing is written while a node is incomplete or a rule is broken, or when the text
+    /// would not read back as this document: the error says what to fix.
     pub fn save_as(&mut self, path: &Path) -> Result<(), String> {
         let (from, to) = (self.folder(), folder_of(path));
         let mut scene = self.scene.clone();
         tracelab_core::rebase_mesh_paths(&mut scene, &from, &to);
-        let text = tracelab_core::write_scene(&scene);
+        let text = self.checked_text(&scene, path)?;
         crate::io::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
         self.scene = scene;
+        self.problems = check_scene(&self.scene);
         for s in self.undo.iter_mut().chain(self.redo.iter_mut()) {
             tracelab_core::rebase_mesh_paths(&mut s.scene, &from, &to);
         }
@@ -273,6 +301,34 @@ impl Document {
         self.saved_state_id = self.state_id;
         self.disk_stamp = modified(path);
         Ok(())
+    }
+
+    /// The text Save As `path` would write, or why it would write nothing (see
+    /// [`Document::save_as`]); writes nothing itself.
+    pub fn text_for(&mut self, path: &Path) -> Result<String, String> {
+        let mut scene = self.scene.clone();
+        tracelab_core::rebase_mesh_paths(&mut scene, &self.folder(), &folder_of(path));
+        self.checked_text(&scene, path)
+    }
+
+    /// The checked writer's text for `scene` (the document rebased for `path`), read back as
+    /// the file at `path` would be, meshes included, and required to be the same document.
+    fn checked_text(&mut self, scene: &Scene, path: &Path) -> Result<String, String> {
+        let name = path.display().to_string();
+        let text = tracelab_core::try_write_scene(scene).map_err(|problems| {
+            let what: Vec<String> = problems.iter().map(|p| format!("  {}", p.message)).collect();
+            format!("{name}: not saved; first fix:\n{}", what.join("\n"))
+        })?;
+        let back = tracelab_core::parse_scene(text.as_bytes(), &name, Some(&folder_of(path)), &mut self.mesh_cache);
+        let why = match back.scene {
+            // Node errors (an OBJ that does not load) open too, as they did here.
+            Some(read) => scene.reads_back_as(&read).err(),
+            None => Some(format!("it would not open again:\n{}", back.diagnostics)),
+        };
+        match why {
+            Some(why) => Err(format!("{name}: not saved, because {why} (a tracelab bug; please report it)")),
+            None => Ok(text),
+        }
     }
 
     pub fn save(&mut self) -> Result<(), String> {
@@ -405,6 +461,31 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn an_incomplete_mesh_is_listed_and_keeps_save_from_writing_until_it_names_a_file() {
+        let d = empty_dir("incomplete");
+        let p = d.join("scene.txt");
+        std::fs::write(&p, crate::DEFAULT_SCENE).expect("write");
+        let mut doc = Document::builtin();
+        doc.open(&p).expect("open");
+        let root = doc.scene.graph.root();
+        let mesh = |obj_file: &str| NodeKind::TriangleMesh { obj_file: obj_file.into(), mesh: tracelab_core::MeshSlot::Failed(String::new()) };
+        doc.apply(Edit::AddNode { parent: root, kind: mesh("") }).expect("an incomplete node is allowed");
+        let Some(Selection::Node(id)) = doc.selection else { panic!("the new node is selected") };
+        let incomplete: Vec<_> = doc.incomplete().map(|p| (p.node(), p.reason.clone())).collect();
+        assert_eq!(incomplete, [(Some(id), "TriangleMesh: no OBJ file chosen yet".to_string())]);
+        let e = doc.save().expect_err("nothing to write yet");
+        assert!(e.contains("not saved") && e.contains("no OBJ file chosen yet"), "{e}");
+        assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);
+        // A name that cannot be written is refused outright; a missing file is only a node error.
+        let refused = doc.apply(Edit::SetNodeKind { node: id, kind: mesh("my mesh.obj") }).expect_err("a space");
+        assert_eq!((refused.place, refused.field.as_str()), (Some(tracelab_core::Place::Node(id)), "obj_file"));
+        doc.apply(Edit::SetNodeKind { node: id, kind: mesh("elsewhere.obj") }).expect("a name");
+        assert_eq!(doc.incomplete().count(), 0);
+        doc.save().expect("saves");
+        assert!(std::fs::read_to_string(&p).expect("read").contains("obj_file elsewhere.obj"));
     }
 
     #[cfg(unix)]

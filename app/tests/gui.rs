@@ -1227,3 +1227,168 @@ fn a_remembered_1000_px_panel_is_clamped_and_reset_layout_restores_the_defaults(
     assert!((tree_edge(&h) - 280.0).abs() < 10.0, "after Reset layout the tree is {} px wide", tree_edge(&h));
     assert!(render_width(&h) > 500, "the view has its default room: {}", render_width(&h));
 }
+
+// Issue 16: nothing the editor lets you do may produce a file it cannot open again. Each
+// test types into the inspector as a user would, saves with Ctrl+S over a copy of the
+// course's squashed-sphere scene, and opens what was saved.
+
+/// scene2_11 (orthographic camera, one light, `Scale 1 0.2 1` around a sphere) copied to a
+/// folder of its own and opened.
+fn squashed_sphere(tag: &str) -> Option<(Harness<'static, TracelabApp>, PathBuf)> {
+    let src = shared_scene("scene2_11_squashed_sphere.txt")?;
+    let path = temp_dir(tag).join("squashed.txt");
+    std::fs::copy(&src, &path).expect("copy");
+    let mut h = harness(Some(path.clone()), (16, 16));
+    settle(&mut h);
+    Some((h, path))
+}
+
+fn select_row(h: &mut Harness<'static, TracelabApp>, label: &str) {
+    h.get_by_label_contains(label).click();
+    h.step();
+    h.step();
+}
+
+/// Focus turns a drag value into a text field; typing replaces the selected old text.
+fn type_into(h: &mut Harness<'static, TracelabApp>, label: &str, text: &str) {
+    let role = egui::accesskit::Role::SpinButton;
+    h.get_by_role_and_label(role, label).focus();
+    h.step();
+    h.step();
+    h.get_by_role_and_label(role, label).type_text(text);
+    h.step();
+    h.key_press(egui::Key::Enter);
+    h.step();
+    h.step();
+}
+
+fn ctrl_s(h: &mut Harness<'static, TracelabApp>) {
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.step();
+    h.step();
+}
+
+/// The saved file, opened again as tracelab opens files.
+fn reopened(path: &Path) -> tracelab_core::Scene {
+    let out = tracelab_core::load_scene(path, &mut MeshCache::new());
+    out.into_result().unwrap_or_else(|d| panic!("the saved file does not open:\n{d}")).0
+}
+
+fn sphere_radius(scene: &tracelab_core::Scene) -> f32 {
+    scene
+        .graph
+        .iter()
+        .find_map(|(_, n)| match n.kind {
+            NodeKind::Sphere { radius, .. } => Some(radius),
+            _ => None,
+        })
+        .expect("a sphere")
+}
+
+#[test]
+fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
+    let Some((mut h, path)) = squashed_sphere("mesh-save") else { return };
+    let before = std::fs::read_to_string(&path).expect("read");
+    h.get_by_label("Add").click();
+    h.step();
+    h.step();
+    h.get_by_label("TriangleMesh").click();
+    h.step();
+    h.step();
+    let Some(Selection::Node(mesh)) = h.state().doc.selection else { panic!("the new mesh is selected") };
+    ctrl_s(&mut h);
+    assert_eq!(std::fs::read_to_string(&path).expect("read"), before, "Save wrote a file with no obj_file");
+    let msg = h.state().doc.messages.join("\n");
+    assert!(msg.contains("not saved") && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)), "{msg}");
+    // The explanation is on screen, and the tree shows the node in red (its row has an error).
+    let _ = h.get_by_label_contains("not saved; first fix");
+    let rows = tracelab::ui::tree::tree_rows(&h.state().doc.scene);
+    assert!(rows.iter().any(|r| r.id == mesh && r.error.is_some()));
+    assert!(h.state().doc.is_dirty(), "nothing was saved");
+}
+
+#[test]
+fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
+    let Some((mut h, path)) = squashed_sphere("nan") else { return };
+    select_row(&mut h, "Sphere: (0, 0, 0) r 1");
+    for text in ["nan", "1e39"] {
+        type_into(&mut h, "radius", text);
+        assert_eq!(sphere_radius(&h.state().doc.scene), 1.0, "{text} was stored as the radius");
+        // Beside the field, the inspector says why.
+        let _ = h.get_by_label("radius must be a finite number");
+    }
+    type_into(&mut h, "radius", "0.5");
+    assert_eq!(sphere_radius(&h.state().doc.scene), 0.5, "a valid value still goes in");
+    ctrl_s(&mut h);
+    assert_eq!(sphere_radius(&reopened(&path)), 0.5);
+}
+
+#[test]
+fn scale_y_zero_on_the_squashed_sphere_is_refused_and_ctrl_s_leaves_a_file_that_opens() {
+    let Some((mut h, path)) = squashed_sphere("scale0") else { return };
+    select_row(&mut h, "Transform: Scale(1, 0.2, 1)");
+    type_into(&mut h, "Scale y", "0");
+    let _ = h.get_by_label("singular transform: Scale(1, 0, 1) flattens space, so rays cannot be moved into object space");
+    ctrl_s(&mut h);
+    let saved = reopened(&path);
+    let scale = saved.graph.iter().find_map(|(_, n)| match &n.kind {
+        NodeKind::Transform(ops) => ops.first().cloned(),
+        _ => None,
+    });
+    assert_eq!(scale, Some(TransformOp::Scale(Vec3::new(1.0, 0.2, 1.0))), "the last valid Scale is kept");
+}
+
+#[test]
+fn an_orthographic_size_of_zero_is_refused_and_the_saved_file_opens() {
+    let Some((mut h, path)) = squashed_sphere("size0") else { return };
+    select_row(&mut h, "Camera (orthographic)");
+    type_into(&mut h, "size", "0");
+    let _ = h.get_by_label("OrthographicCamera: size must be positive, found 0");
+    ctrl_s(&mut h);
+    assert!(matches!(reopened(&path).camera, tracelab_core::Camera::Orthographic { size: 2.5, .. }));
+}
+
+#[test]
+fn a_camera_direction_parallel_to_up_is_refused_and_the_saved_file_opens() {
+    let Some((mut h, path)) = squashed_sphere("parallel") else { return };
+    select_row(&mut h, "Camera (orthographic)");
+    // (0, 0, -1) → (0, 1, -1), fine → (0, 1, 0), along up.
+    type_into(&mut h, "direction y", "1");
+    type_into(&mut h, "direction z", "0");
+    let _ = h.get_by_label("OrthographicCamera: up must not be zero or parallel to direction");
+    assert_eq!(h.state().doc.scene.camera.direction(), Vec3::new(0.0, 1.0, -1.0), "the last valid direction");
+    ctrl_s(&mut h);
+    assert_eq!(reopened(&path).camera.direction(), Vec3::new(0.0, 1.0, -1.0));
+}
+
+#[test]
+fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
+    let Some((mut h, path)) = squashed_sphere("light0") else { return };
+    select_row(&mut h, "Light 0");
+    for axis in ["x", "y", "z"] {
+        type_into(&mut h, &format!("direction {axis}"), "0");
+    }
+    let _ = h.get_by_label("DirectionalLight: direction must not be zero");
+    assert_eq!(h.state().doc.scene.lights()[0].direction, Vec3::new(0.0, 0.0, -1.0));
+    ctrl_s(&mut h);
+    assert_eq!(reopened(&path).lights()[0].direction, Vec3::new(0.0, 0.0, -1.0));
+}
+
+#[test]
+fn a_tiny_uniform_scale_is_fine_and_the_saved_file_opens() {
+    let Some((mut h, path)) = squashed_sphere("tiny") else { return };
+    select_row(&mut h, "Transform: Scale(1, 0.2, 1)");
+    h.get_by_label("Add op").click();
+    h.step();
+    h.step();
+    h.get_by_label("UniformScale").click();
+    h.step();
+    h.step();
+    type_into(&mut h, "UniformScale", "0.0001");
+    ctrl_s(&mut h);
+    let saved = reopened(&path);
+    assert!(
+        saved.graph.iter().any(|(_, n)| matches!(&n.kind, NodeKind::Transform(ops) if ops.contains(&TransformOp::UniformScale(0.0001)))),
+        "the saved file holds the tiny scale"
+    );
+}

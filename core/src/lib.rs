@@ -8,7 +8,7 @@ pub mod geometry;
 pub mod render;
 pub mod scene;
 
-pub use format::{Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, parse_scene, rebase_mesh_paths, write_scene};
+pub use format::{Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, parse_scene, rebase_mesh_paths, try_write_scene, write_scene};
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
 pub use render::{
     CompiledScene, Frame, NormalTransform, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
@@ -17,7 +17,7 @@ pub use render::{
 pub use scene::{
     DEFAULT_MATERIAL_COLOR,
     Anchor, Background, Comments, SceneComments, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
-    NodeKind, Scene, TransformOp,
+    NodeKind, Scene, TransformOp, Invalid, Place, Problem, check_scene,
 };
 
 /// Helpers for this crate's unit tests.

@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use common::{Rng, fuzz_cases, mutate_text, quoted};
 use tracelab_core::format::obj::{load_with_tobj, parse_obj, parse_obj_fast};
-use tracelab_core::{Frame, MeshCache, RenderSettings, Scene, compile, parse_scene, render_frame, write_scene};
+use tracelab_core::{Frame, MeshCache, RenderSettings, Scene, check_scene, compile, parse_scene, render_frame, write_scene};
 
 /// One case taking longer than this is a hang (cases take well under a millisecond).
 const CASE_LIMIT_MS: u64 = 20_000;
@@ -228,6 +228,12 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
     if out.diagnostics.has_errors() {
         // Node errors (a mesh that did not load): usable, but not a clean scene to round-trip.
         return Ok(());
+    }
+    // One rule set: whatever the parser accepts passes every rule the editor and the
+    // checked writer apply.
+    let problems = check_scene(&scene);
+    if !problems.is_empty() {
+        return Err(format!("an accepted scene breaks a validity rule: {}", problems[0]));
     }
     let text = write_scene(&scene);
     let back = parse_scene(text.as_bytes(), "written.txt", Some(dir), cache);

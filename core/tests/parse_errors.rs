@@ -250,3 +250,72 @@ fn no_input_panics_the_parser() {
         }
     }
 }
+
+// Issue 11, "renders that are silently wrong": each is now an error with its location, or
+// (strong scales, huge vectors) accepted and rendered right (tests/validity_render.rs).
+
+fn one_object(object: &str) -> String {
+    body(&format!("Group {{\n numObjects 1\n MaterialIndex 0\n{object}}}\n"))
+}
+
+#[test]
+fn a_projective_matrix_is_an_error_not_the_identity() {
+    let e = errors(&one_object(" Transform {\n  Matrix { 1 0 0 0  0 1 0 0  0 0 1 0  0.5 0 0 1 }\n  Sphere { center 0 0 0 radius 1 }\n }\n"));
+    assert_eq!(
+        e,
+        [format!("{} Matrix: the last row must be 0 0 0 1 (a projective matrix cannot move rays), found 0.5 0 0 1", at(5, 3))]
+    );
+}
+
+#[test]
+fn a_zero_rotate_axis_is_an_error_not_the_identity() {
+    let e = errors(&one_object(" Transform {\n  Rotate { 0 0 0 45 }\n  Sphere { center 0 0 0 radius 1 }\n }\n"));
+    assert_eq!(e, [format!("{} Rotate: the axis must not be zero", at(5, 3))]);
+}
+
+#[test]
+fn a_negative_or_zero_radius_is_an_error_not_its_absolute_value() {
+    let e = errors(&one_object(" Sphere { center 0 0 0 radius -1 }\n"));
+    assert_eq!(e, [format!("{} Sphere: radius must be positive, found -1", at(4, 2))]);
+    let e = errors(&one_object(" Sphere { center 0 0 0 radius 0 }\n"));
+    assert_eq!(e, [format!("{} Sphere: radius must be positive, found 0", at(4, 2))]);
+}
+
+#[test]
+fn tiny_and_huge_uniform_scales_are_accepted_and_nested_ones_judged_together() {
+    for s in ["0.0001", "1e13"] {
+        let out = parse(&one_object(&format!(" Transform {{\n  UniformScale {s}\n  Sphere {{ center 0 0 0 radius 1 }}\n }}\n")));
+        assert!(!out.diagnostics.has_errors(), "{s}: {}", out.diagnostics);
+    }
+    // Each squashes y by 1e-4, fine alone; together 1e-8 leaves f32 no digits.
+    let e = errors(&one_object(
+        " Transform {\n  Scale 1 0.0001 1\n  Transform {\n   Scale 1 0.0001 1\n   Sphere { center 0 0 0 radius 1 }\n  }\n }\n",
+    ));
+    assert_eq!(
+        e,
+        [format!(
+            "{} singular transform: the combined transforms down to here squashes one direction so much more than another that rays lose all precision",
+            at(6, 3)
+        )]
+    );
+    // Three 1e13 scales (1e39) leave f32's range: reported once, at the Transform that does.
+    let mut nested = "Sphere { center 0 0 0 radius 1 }".to_string();
+    for _ in 0..4 {
+        nested = format!("Transform {{ UniformScale 1e13 {nested} }}");
+    }
+    let e = errors(&one_object(&format!(" {nested}\n")));
+    assert_eq!(e, [format!("{} singular transform: the combined transforms down to here overflows", at(4, 62))]);
+}
+
+#[test]
+fn overflowing_vector_lengths_are_accepted_as_directions() {
+    let src = "OrthographicCamera { center 0 0 10 direction 0 0 -3e38 up 0 1 0 size 5 }\n\
+               Lights { numLights 1 DirectionalLight { direction 0 -1e20 -1e20 color 1 1 1 } }\n\
+               Materials { numMaterials 1 Material { diffuseColor 1 0 0 } }\n\
+               Group { numObjects 1 MaterialIndex 0 Plane { normal 0 0 1e20 offset 0 } }\n";
+    let out = parse(src);
+    assert!(!out.diagnostics.has_errors(), "{}", out.diagnostics);
+    // A camera direction really parallel to up is still one, however long.
+    let e = errors(&src.replace("0 0 -3e38 up", "0 3e38 0 up"));
+    assert_eq!(e, ["1:1: OrthographicCamera: up must not be zero or parallel to direction"]);
+}

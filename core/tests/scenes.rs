@@ -6,7 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use tracelab_core::format::uses_only_course_grammar;
-use tracelab_core::{Frame, MeshCache, NormalTransform, RenderSettings, Scene, compile, load_scene, render_frame, write_scene};
+use tracelab_core::{
+    Frame, MeshCache, NormalTransform, RenderSettings, Scene, check_scene, compile, load_scene, render_frame, write_scene,
+};
 
 /// Libtest swallows `eprintln!` from passing tests, and a skip must be seen: write to the
 /// process's stderr directly.
@@ -99,6 +101,9 @@ fn check_file(path: &Path) {
     let scene = load(path);
     let (text, back) = round_trip(path, &scene);
     assert_eq!(back, scene, "{}: read → write → read changed the scene", path.display());
+    // Every scene the reader accepts passes every rule, and Save's check agrees it reads back.
+    assert_eq!(check_scene(&scene), [], "{}", path.display());
+    assert_eq!(scene.reads_back_as(&back), Ok(()), "{}", path.display());
     if uses_only_course_grammar(&scene) {
         assert_course_grammar(&text, &path.display().to_string());
     } else {
@@ -203,4 +208,24 @@ fn scene_without_lights_is_flat_in_diffuse_colours() {
         .map(|m| [m.diffuse.x, m.diffuse.y, m.diffuse.z].map(tracelab_core::render::quantize))
         .collect();
     assert_eq!(colors, expected);
+}
+
+#[test]
+fn save_s_read_back_check_names_what_would_change() {
+    let path = repo().join("scenes/default.txt");
+    let scene = load(&path);
+    let mut other = scene.clone();
+    if let Some(l) = other.lights.as_mut().and_then(|l| l.first_mut()) {
+        l.color.x += 0.5;
+    }
+    assert_eq!(scene.reads_back_as(&other), Err("the lights would read back differently".into()));
+    // Spelling out a material a list continues changes nothing the file says.
+    let mut spelt = scene.clone();
+    spelt.graph = spelt.graph.with_listed_materials();
+    assert_eq!(scene.reads_back_as(&spelt), Ok(()));
+    let mut recoloured = scene.clone();
+    let root = recoloured.graph.root();
+    let first = recoloured.graph.node(root).children[0];
+    recoloured.graph.node_mut(first).material = Some(4);
+    assert_eq!(scene.reads_back_as(&recoloured), Err("the objects would read back differently".into()));
 }

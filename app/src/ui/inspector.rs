@@ -3,14 +3,23 @@
 
 use egui::DragValue;
 use glam::{Mat4, Vec3};
-use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, TransformOp};
+use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp};
 
-use crate::edit::Edit;
+use crate::edit::{Edit, Refusal};
 use crate::state::{Document, Selection};
 use crate::ui::drag_speed::{DragSpeeds, world_per_unit};
 
 pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
     let mut edits = Vec::new();
+    let place = match doc.selection {
+        Some(Selection::Camera) => Some(Place::Camera),
+        Some(Selection::Background) => Some(Place::Background),
+        Some(Selection::Light(i)) => Some(Place::Light(i)),
+        Some(Selection::Material(i)) => Some(Place::Material(i)),
+        Some(Selection::Node(id)) => Some(Place::Node(id)),
+        _ => None,
+    };
+    show_refusal_for(ui, doc, place);
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| match doc.selection {
@@ -63,6 +72,7 @@ pub fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
             name_widget(&r, format!("{name} {axis}"), f64::from(*c));
             changed |= r.changed();
         }
+        refusal_note(ui, name);
     });
     changed
 }
@@ -80,9 +90,59 @@ fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
         ui.label(name);
         let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
         name_widget(&r, name.to_string(), f64::from(*v));
+        refusal_note(ui, name);
         r.changed()
     })
     .inner
+}
+
+/// What the last refused edit said, while the inspector draws the place it was about. In
+/// egui's memory for the frame, so `vec3`, `scalar` and `color` show it beside the field it
+/// names without a parameter each.
+#[derive(Clone)]
+struct Note {
+    field: String,
+    op: Option<usize>,
+    reason: String,
+}
+
+fn note_id() -> egui::Id {
+    egui::Id::unique("tracelab-refusal-note")
+}
+
+/// The op being drawn, so a refusal for op 2 shows beside op 2's fields only.
+fn op_id() -> egui::Id {
+    egui::Id::unique("tracelab-refusal-op")
+}
+
+fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Place>) {
+    let note = doc
+        .refusal
+        .as_ref()
+        .filter(|r: &&Refusal| r.place.is_some() && r.place == place)
+        .map(|r| Note { field: r.field.clone(), op: r.op, reason: r.reason.clone() });
+    ui.data_mut(|d| {
+        d.insert_temp(note_id(), note);
+        d.insert_temp(op_id(), None::<usize>);
+    });
+}
+
+/// Whether the widget labelled `label` edits the file's field `field` ("angle (degrees)"
+/// edits "angle", "Rotate axis" edits "Rotate", "colour" edits "color").
+fn same_field(label: &str, field: &str) -> bool {
+    let label = label.split(" (").next().unwrap_or(label);
+    label == field
+        || label.strip_prefix(field).is_some_and(|rest| rest.starts_with(' '))
+        || matches!((label, field), ("colour", "color") | ("ambient light", "ambientLight"))
+        || (label.ends_with(": diffuse") && field == "diffuseColor")
+}
+
+fn refusal_note(ui: &mut egui::Ui, label: &str) {
+    let (note, op) = ui.data(|d| (d.get_temp::<Option<Note>>(note_id()).flatten(), d.get_temp::<Option<usize>>(op_id()).flatten()));
+    if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
+        // Wrapped in what is left of the row: a long reason must not widen the panel.
+        ui.add(egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color)).wrap());
+    }
 }
 
 fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
@@ -102,6 +162,7 @@ fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
                 .changed();
         }
         *c = Vec3::from_array(rgb);
+        refusal_note(ui, name);
         changed || changed2
     })
     .inner
@@ -168,6 +229,7 @@ fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
         return;
     };
     let mut l = l.clone();
+    show_refusal_for(ui, doc, Some(Place::Light(i)));
     ui.strong(format!("Light {i} (directional)"));
     let mut changed = vec3(ui, "direction", &mut l.direction, 0.01);
     changed |= color(ui, "colour", &mut l.color);
@@ -207,6 +269,7 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
         return;
     };
     let mut m = m.clone();
+    show_refusal_for(ui, doc, Some(Place::Material(i)));
     ui.horizontal(|ui| {
         let mut c = m.diffuse;
         if color(ui, &format!("{i}: diffuse"), &mut c) {
@@ -259,6 +322,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
                     ui.selectable_value(&mut chosen, Some(m), text(Some(m)));
                 }
             });
+        refusal_note(ui, "material");
         if chosen != current {
             edits.push(Edit::SetNodeMaterial {
                 node: id,
@@ -325,6 +389,7 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
             ui.horizontal(|ui| {
                 ui.label("obj_file");
                 ui.text_edit_singleline(&mut path);
+                refusal_note(ui, "obj_file");
             });
             if path == *obj_file {
                 ui.data_mut(|d| d.remove::<String>(buf_id));
@@ -433,9 +498,12 @@ fn op_names() -> [(&'static str, TransformOp); 8] {
 /// `lengths[i]`: the drag speed of a length in the space op `i` acts in.
 fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengths: &[f64], edits: &mut Vec<Edit>) {
     ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
+    // The ops together (or the chain above them) flatten space.
+    refusal_note(ui, "ops");
     let n = ops.len();
     for (index, op) in ops.iter_mut().enumerate() {
         ui.push_id(index, |ui| {
+            ui.data_mut(|d| d.insert_temp(op_id(), Some(index)));
             ui.group(|ui| {
                 let len = lengths.get(index).copied().unwrap_or(0.02);
                 let changed = match op {
@@ -483,6 +551,7 @@ fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengt
             });
         });
     }
+    ui.data_mut(|d| d.insert_temp(op_id(), None::<usize>));
     ui.menu_button("Add op", |ui| {
         for (name, op) in op_names() {
             if ui.button(name).clicked() {
@@ -496,7 +565,10 @@ fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengt
 /// A 4×4 matrix edited row by row, as the file writes it.
 fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
     let mut changed = false;
-    ui.label("Matrix (rows)");
+    ui.horizontal(|ui| {
+        ui.label("Matrix (rows)");
+        refusal_note(ui, "Matrix");
+    });
     let mut rows = [
         m.row(0).to_array(),
         m.row(1).to_array(),

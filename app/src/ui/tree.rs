@@ -15,6 +15,8 @@ pub struct TreeRow {
     pub label: String,
     /// Material the node renders with (`None`: the default material).
     pub material: Option<u32>,
+    /// Why the node renders nothing or cannot be saved yet (a mesh that did not load, one
+    /// with no file chosen): drawn in red.
     pub error: Option<String>,
 }
 
@@ -59,6 +61,14 @@ pub fn node_label(kind: &NodeKind, children: usize) -> String {
 pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
     let g = &scene.graph;
     let mats = g.effective_materials();
+    // The same rules the editor and Save apply; an edited document breaks none but
+    // "incomplete" ones.
+    let mut problems: std::collections::HashMap<NodeId, String> = std::collections::HashMap::new();
+    for p in tracelab_core::check_scene(scene) {
+        if let Some(id) = p.node() {
+            problems.entry(id).or_insert(p.reason);
+        }
+    }
     let mut rows = Vec::new();
     let mut stack = vec![(g.root(), 0usize)];
     while let Some((id, depth)) = stack.pop() {
@@ -70,6 +80,7 @@ pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
             } => Some(e.clone()),
             _ => None,
         };
+        let error = problems.remove(&id).or(error);
         rows.push(TreeRow {
             id,
             depth,

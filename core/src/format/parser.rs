@@ -15,7 +15,7 @@ use super::obj::{MeshCache, resolve_obj_path};
 
 use crate::scene::{
     Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node,
-    NodeId, NodeKind, Scene, SceneComments, TransformOp, check_closed, compose,
+    NodeId, NodeKind, Scene, SceneComments, TransformOp, check_closed, validate,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -211,7 +211,7 @@ enum Frame {
         node: NodeId,
         keyword: usize,
         open: usize,
-        ops: Vec<(TransformOp, usize)>,
+        ops: Vec<TransformOp>,
         has_child: bool,
     },
     /// Union, Intersection or Subtraction: operands, with MaterialIndex as in a Group.
@@ -247,7 +247,8 @@ fn block_comments(before: Vec<String>, fields: &mut [Field], end: Vec<String>) -
     c
 }
 
-fn is_numberlike(s: &str) -> bool {
+/// Whether the reader takes this word as a number (a bad one is an error, never a name).
+pub(crate) fn is_numberlike(s: &str) -> bool {
     let first = s.as_bytes().first().copied().unwrap_or(b'a');
     first.is_ascii_digit()
         || matches!(first, b'-' | b'+' | b'.')
@@ -664,27 +665,16 @@ impl<'a> Parser<'a> {
         let (Some(center), Some(direction), Some(up), Some(extent)) = (center, direction, up, extent) else {
             return;
         };
-        if direction.length_squared() == 0.0 {
-            self.error(off, format!("{kw}: direction must not be zero"));
-            return;
-        }
-        if up.cross(direction).length_squared() <= 1e-12 * up.length_squared() * direction.length_squared() {
-            self.error(off, format!("{kw}: up must not be zero or parallel to direction"));
-            return;
-        }
-        if perspective && !(extent > 0.0 && extent < 180.0) {
-            self.error(off, format!("PerspectiveCamera: angle must be between 0 and 180 degrees, found {extent}"));
-            return;
-        }
-        if !perspective && extent <= 0.0 {
-            self.error(off, format!("OrthographicCamera: size must be positive, found {extent}"));
-            return;
-        }
-        self.camera = Some(if perspective {
+        let camera = if perspective {
             Camera::Perspective { center, direction, up, angle: extent }
         } else {
             Camera::Orthographic { center, direction, up, size: extent }
-        });
+        };
+        if let Err(e) = validate::check_camera(&camera) {
+            self.error(off, e.message);
+            return;
+        }
+        self.camera = Some(camera);
     }
 
     fn parse_background(&mut self, off: usize) {
@@ -740,10 +730,11 @@ impl<'a> Parser<'a> {
                     let c = self.take_vec3(&mut f, "DirectionalLight", t.start, "color");
                     self.reject_unused(&f, "DirectionalLight", "direction, color");
                     if let (Some(direction), Some(color)) = (d, c) {
-                        if direction.length_squared() == 0.0 {
-                            self.error(t.start, "DirectionalLight: direction must not be zero");
+                        let light = Light { direction, color, comments: light_comments };
+                        if let Err(e) = validate::check_light(&light) {
+                            self.error(t.start, e.message);
                         }
-                        lights.push(Light { direction, color, comments: light_comments });
+                        lights.push(light);
                     }
                 }
                 (_, w) => {
@@ -972,7 +963,7 @@ impl<'a> Parser<'a> {
                                             if !c.is_empty() {
                                                 graph.node_mut(parent).comments.inner.entry(Anchor::Op(ops.len())).or_default().extend(c);
                                             }
-                                            ops.push((op, t.start))
+                                            ops.push(op)
                                         }
                                         _ => self.error(t.start, "transform operations must come before the Transform's object"),
                                     }
@@ -1052,6 +1043,15 @@ impl<'a> Parser<'a> {
     /// Parses a transform op after its keyword. Reports and returns None on failure
     /// (including an unknown keyword).
     fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
+        let op = self.parse_op_numbers(w, off)?;
+        if let Err(e) = validate::check_op(&op) {
+            self.error(off, e.message);
+            return None;
+        }
+        Some(op)
+    }
+
+    fn parse_op_numbers(&mut self, w: &str, off: usize) -> Option<TransformOp> {
         let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
         Some(match w {
             "Scale" => TransformOp::Scale(v3(self.op_numbers(w, 3)?)),
@@ -1155,12 +1155,7 @@ impl<'a> Parser<'a> {
                 let normal = self.take_vec3(&mut f, w, off, "normal");
                 let offset = self.take_f32(&mut f, w, off, "offset");
                 self.reject_unused(&f, w, "normal, offset");
-                let normal = normal?;
-                if normal.length_squared() == 0.0 {
-                    self.error(off, "Plane: normal must not be zero");
-                    return None;
-                }
-                NodeKind::Plane { normal, offset: offset? }
+                NodeKind::Plane { normal: normal?, offset: offset? }
             }
             "Triangle" => {
                 let a = self.take_vec3(&mut f, w, off, "vertex0");
@@ -1173,12 +1168,7 @@ impl<'a> Parser<'a> {
                 let min = self.take_vec3(&mut f, w, off, "min");
                 let max = self.take_vec3(&mut f, w, off, "max");
                 self.reject_unused(&f, w, "min, max");
-                let (min, max) = (min?, max?);
-                if min.cmpgt(max).any() {
-                    self.error(off, "Box: min must not exceed max on any axis");
-                    return None;
-                }
-                NodeKind::Box { min, max }
+                NodeKind::Box { min: min?, max: max? }
             }
             "TriangleMesh" => {
                 let Some(i) = f.iter().position(|x| x.name == "obj_file") else {
@@ -1193,6 +1183,10 @@ impl<'a> Parser<'a> {
             }
             _ => return None,
         };
+        if let Err(e) = validate::check_kind(&kind) {
+            self.error(off, e.message);
+            return None;
+        }
         Some((kind, comments))
     }
 
@@ -1239,18 +1233,9 @@ impl<'a> Parser<'a> {
                 if !has_child {
                     self.error(keyword, "Transform needs one object after its operations");
                 }
-                let m = compose(&ops.iter().map(|o| o.0.clone()).collect::<Vec<_>>());
-                let det = m.determinant();
-                if !det.is_finite() || det.abs() < 1e-12 {
-                    // Point at the op that flattens space, if one does on its own.
-                    let (what, at) = ops
-                        .iter()
-                        .find(|(op, _)| op.matrix().determinant().abs() < 1e-12)
-                        .map(|(op, at)| (op.summary(), *at))
-                        .unwrap_or(("the combined operations".to_string(), keyword));
-                    self.error(at, format!("singular transform: {what} flattens space, so rays cannot be moved into object space"));
-                }
-                graph.node_mut(node).kind = NodeKind::Transform(ops.into_iter().map(|o| o.0).collect());
+                // Ops were checked one by one as read; their product is checked with the
+                // whole chain above it once the tree is complete.
+                graph.node_mut(node).kind = NodeKind::Transform(ops);
             }
         }
     }
@@ -1319,6 +1304,13 @@ impl<'a> Parser<'a> {
         }
         if self.graph.is_none() && !self.group_seen {
             self.error(end, "the scene has no Group of objects");
+        }
+        if let Some(graph) = &self.graph {
+            // Composed through each chain, so nested scales are judged together.
+            for p in validate::check_world_chain(graph) {
+                let at = p.node().and_then(|id| self.node_offsets.get(id.index()).copied()).unwrap_or(0);
+                self.error(at, p.message);
+            }
         }
         if let Some(graph) = &self.graph {
             let eff = graph.effective_materials();

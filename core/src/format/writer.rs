@@ -8,7 +8,9 @@ use std::fmt::Write as _;
 
 use glam::Vec3;
 
-use crate::scene::{Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Scene, TransformOp};
+use crate::scene::{
+    Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Problem, Scene, TransformOp, check_scene,
+};
 
 const IND: &str = "    ";
 /// Indentation stops growing past this depth, so a file with tens of thousands of nested
@@ -73,6 +75,14 @@ impl<'a> Inner<'a> {
     }
 }
 
+/// The scene's text, if it passes every validity rule ([`crate::scene::check_scene`]);
+/// otherwise what must be fixed first, and nothing is written.
+pub fn try_write_scene(scene: &Scene) -> Result<String, Vec<Problem>> {
+    let problems = check_scene(scene);
+    if problems.is_empty() { Ok(write_scene(scene)) } else { Err(problems) }
+}
+
+/// The scene's text, unchecked: a scene that breaks a rule gives text the parser rejects.
 pub fn write_scene(scene: &Scene) -> String {
     let mut out = String::new();
     let sc = &scene.comments;
@@ -349,5 +359,55 @@ mod tests {
         let render = |s| render_frame(&compile(s), &RenderSettings::new(4, 4));
         let (a, b) = (render(&scene), render(&back));
         assert!(a.samples.iter().zip(&b.samples).all(|(x, y)| x.color == y.color && x.t.to_bits() == y.t.to_bits()));
+    }
+
+    const TWO: &str = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
+                       Lights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\n\
+                       Materials { numMaterials 2 Material { diffuseColor 1 0 0 } Material { diffuseColor 0 1 0 } }\n\
+                       Group { numObjects 2 MaterialIndex 1 Sphere { center -1 0 0 radius 1 } Sphere { center 1 0 0 radius 1 } }\n";
+
+    fn two() -> Scene {
+        parse_scene(TWO.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0
+    }
+
+    #[test]
+    fn the_checked_writer_writes_nothing_for_a_scene_that_breaks_a_rule() {
+        let scene = two();
+        assert_eq!(try_write_scene(&scene), Ok(write_scene(&scene)));
+        let mut bad = scene.clone();
+        if let Some(l) = bad.lights.as_mut().and_then(|l| l.first_mut()) {
+            l.direction = Vec3::ZERO;
+        }
+        let p = try_write_scene(&bad).expect_err("a zero light direction");
+        assert_eq!(p.len(), 1);
+        assert_eq!((p[0].place, p[0].field.as_str()), (crate::scene::Place::Light(0), "direction"));
+        assert_eq!(p[0].message, "light 0: DirectionalLight: direction must not be zero");
+        // An incomplete node (a mesh with no file yet) is never written either.
+        let mut incomplete = scene;
+        let root = incomplete.graph.root();
+        let mesh = incomplete.graph.add(crate::scene::Node::new(NodeKind::TriangleMesh {
+            obj_file: String::new(),
+            mesh: crate::scene::MeshSlot::Failed(String::new()),
+        }));
+        incomplete.graph.push_child(root, mesh);
+        let p = try_write_scene(&incomplete).expect_err("no OBJ file");
+        assert!(p.len() == 1 && p[0].incomplete && p[0].node() == Some(mesh), "{p:?}");
+    }
+
+    #[test]
+    fn an_object_without_its_own_material_continues_its_list_as_the_file_says() {
+        // The parser spells the continued material out; an edit can leave it unset. The file
+        // has no way to say "not the one before me", so the graph means what the text means.
+        let mut scene = two();
+        let root = scene.graph.root();
+        let second = scene.graph.node(root).children[1];
+        scene.graph.node_mut(second).material = None;
+        assert_eq!(scene.graph.effective_materials()[second.index()], Some(1));
+        let text = write_scene(&scene);
+        let back = parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("reparses").0;
+        assert_eq!(back.graph, scene.graph.with_listed_materials());
+        let render = |s| render_frame(&compile(s), &RenderSettings::new(8, 8));
+        let (a, b) = (render(&scene), render(&back));
+        assert!(a.samples.iter().zip(&b.samples).all(|(x, y)| x.color == y.color), "same colours before and after");
     }
 }

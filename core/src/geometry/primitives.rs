@@ -15,7 +15,12 @@ pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> 
     let half_b = oc.dot(ray.direction);
     let c = oc.length_squared() - radius * radius;
     let disc = half_b * half_b - a * c;
-    if disc < 0.0 || a == 0.0 {
+    // Under a strong scale (a radius-1e10 sphere inside ten UniformScale 0.1) the squares
+    // leave f32's range: solve those rare rays in f64 instead of missing them.
+    if !(disc.is_finite() && a.is_normal() && (half_b * half_b).is_finite()) {
+        return sphere_roots_f64(ray, center, radius);
+    }
+    if disc < 0.0 {
         return None;
     }
     let sq = disc.sqrt();
@@ -23,6 +28,23 @@ pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> 
     let q = -half_b - sq.copysign(half_b);
     let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
     Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+}
+
+#[cold]
+fn sphere_roots_f64(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
+    let oc = (ray.origin - center).as_dvec3();
+    let d = ray.direction.as_dvec3();
+    let a = d.length_squared();
+    let half_b = oc.dot(d);
+    let c = oc.length_squared() - f64::from(radius) * f64::from(radius);
+    let disc = half_b * half_b - a * c;
+    if !(disc >= 0.0 && a > 0.0 && disc.is_finite()) {
+        return None;
+    }
+    let q = -half_b - disc.sqrt().copysign(half_b);
+    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    let (t0, t1) = if t0 > t1 { (t1, t0) } else { (t0, t1) };
+    Some((t0 as f32, t1 as f32))
 }
 
 /// Smallest root of |o + t d − c|² = r² in (t_min, t_max).

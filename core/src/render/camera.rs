@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use crate::geometry::Ray;
-use crate::scene::Camera;
+use crate::scene::{Camera, unit};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRays {
@@ -26,8 +26,9 @@ impl CameraRays {
                 (center, direction, up, 2.0 * (angle.to_radians() * 0.5).tan(), true)
             }
         };
-        let direction = dir.normalize_or(Vec3::NEG_Z);
-        let horizontal = direction.cross(up).normalize_or(Vec3::X);
+        // Overflow-safe: a direction of 0 0 -3e38 is just -z.
+        let direction = unit(dir).unwrap_or(Vec3::NEG_Z);
+        let horizontal = direction.cross(unit(up).unwrap_or(Vec3::Y)).normalize_or(Vec3::X);
         let up = horizontal.cross(direction);
         CameraRays { center, direction, horizontal, up, extent, perspective }
     }

@@ -5,14 +5,15 @@
 
 use std::sync::Arc;
 
-use glam::{Mat3, Mat4, Vec3, Vec3A};
+use glam::{DMat4, Mat3, Mat4, Vec3, Vec3A};
 
 use super::camera::CameraRays;
 use super::csg::{CsgTree, box_face_normal, box_span};
 use super::NormalTransform;
 use crate::accel::Bvh;
 use crate::geometry::{Aabb, Ray, intersect_plane, intersect_sphere, intersect_triangle, triangle_normal};
-use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, compose};
+use crate::scene::validate::compose_f64;
+use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
 
 #[derive(Clone, Debug)]
 pub enum Shape {
@@ -40,7 +41,16 @@ pub struct Xf {
 impl Xf {
     /// Inverts once, here, so no ray ever pays for it.
     pub fn new(world_from_object: Mat4) -> Xf {
-        let inv = world_from_object.inverse();
+        Self::from_pair(world_from_object, world_from_object.inverse())
+    }
+
+    /// From a matrix composed in f64: inverted there, so tiny and huge scales keep their
+    /// digits in the f32 pair.
+    pub fn from_f64(world_from_object: DMat4) -> Xf {
+        Self::from_pair(world_from_object.as_mat4(), world_from_object.inverse().as_mat4())
+    }
+
+    fn from_pair(world_from_object: Mat4, inv: Mat4) -> Xf {
         Xf { world_from_object, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
     }
 }
@@ -92,19 +102,19 @@ impl CompiledScene {
         let g = &scene.graph;
         let mut objects = Vec::new();
         // (node, world_from_object, material in effect)
-        let mut stack = vec![(g.root(), Mat4::IDENTITY, None::<u32>)];
+        let mut stack = vec![(g.root(), DMat4::IDENTITY, None::<u32>)];
         while let Some((id, m, inherited)) = stack.pop() {
             let Some(node) = g.get(id) else { continue };
             let material = node.material.or(inherited);
             let shape = match &node.kind {
                 NodeKind::Group => {
-                    for &c in node.children.iter().rev() {
-                        stack.push((c, m, material));
+                    for (c, inherited) in g.list_materials(node, material).into_iter().rev() {
+                        stack.push((c, m, inherited));
                     }
                     continue;
                 }
                 NodeKind::Transform(ops) => {
-                    let m = m * compose(ops);
+                    let m = m * compose_f64(ops);
                     for &c in node.children.iter().rev() {
                         stack.push((c, m, material));
                     }
@@ -114,7 +124,7 @@ impl CompiledScene {
                 NodeKind::Plane { normal, offset } => {
                     // The offset is measured along the normalised normal, as the course's
                     // Plane does.
-                    Shape::Plane { normal: normal.normalize_or(Vec3::Y), offset: *offset }
+                    Shape::Plane { normal: unit(*normal).unwrap_or(Vec3::Y), offset: *offset }
                 }
                 NodeKind::Triangle { vertices: [a, b, c] } => {
                     Shape::Triangle { vertices: [*a, *b, *c], normal: triangle_normal(*a, *b, *c) }
@@ -131,7 +141,7 @@ impl CompiledScene {
                     continue;
                 }
             };
-            let xf = (m != Mat4::IDENTITY).then(|| Xf::new(m));
+            let xf = (m != DMat4::IDENTITY).then(|| Xf::from_f64(m));
             let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
             objects.push(Object { shape, xf, material, node: id });
         }
@@ -162,7 +172,7 @@ impl CompiledScene {
         let lights = scene
             .lights()
             .iter()
-            .map(|l| (-l.direction.normalize_or(Vec3::NEG_Z), l.color))
+            .map(|l| (-unit(l.direction).unwrap_or(Vec3::NEG_Z), l.color))
             .collect();
         CompiledScene {
             camera: CameraRays::new(&scene.camera),

@@ -9,13 +9,14 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::{DMat4, Vec3};
 
 use super::NormalTransform;
 use super::compile::Xf;
 use crate::accel::TriangleHit;
 use crate::geometry::{Aabb, Ray, sphere_roots};
-use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, compose};
+use crate::scene::validate::compose_f64;
+use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
 
 /// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low
 /// bits, whether the ray leaves that leaf there, and whether the normal is flipped (a
@@ -115,12 +116,12 @@ impl CsgTree {
     pub fn build(
         graph: &Graph,
         root: NodeId,
-        world_from_root: Mat4,
+        world_from_root: DMat4,
         material: Option<u32>,
         resolve: &dyn Fn(Option<u32>) -> u32,
     ) -> CsgTree {
         enum Work {
-            Visit(Option<NodeId>, Mat4, Option<u32>),
+            Visit(Option<NodeId>, DMat4, Option<u32>),
             Emit(CsgOp),
         }
         let mut leaves = Vec::new();
@@ -141,19 +142,22 @@ impl CsgTree {
                     let children = node.map_or(&[][..], |n| n.children.as_slice());
                     // Exactly two operands; an edited scene may hold fewer, read as empty.
                     stack.push(Work::Emit(*op));
-                    stack.push(Work::Visit(children.get(1).copied(), m, material));
-                    stack.push(Work::Visit(children.first().copied(), m, material));
+                    // Operands are a list: a MaterialIndex before A holds for B too.
+                    let listed = node.map(|n| graph.list_materials(n, material)).unwrap_or_default();
+                    let inherited = |i: usize| listed.get(i).map_or(material, |l| l.1);
+                    stack.push(Work::Visit(children.get(1).copied(), m, inherited(1)));
+                    stack.push(Work::Visit(children.first().copied(), m, inherited(0)));
                     continue;
                 }
                 Some(NodeKind::Transform(ops)) => {
                     let child = node.and_then(|n| n.children.first().copied());
-                    stack.push(Work::Visit(child, m * compose(ops), material));
+                    stack.push(Work::Visit(child, m * compose_f64(ops), material));
                     continue;
                 }
                 Some(NodeKind::Sphere { center, radius }) => Solid::Sphere { center: *center, radius: *radius },
                 Some(NodeKind::Box { min, max }) => Solid::Box { min: *min, max: *max },
                 Some(NodeKind::Plane { normal, offset }) => {
-                    Solid::HalfSpace { normal: normal.normalize_or(Vec3::Y), offset: *offset }
+                    Solid::HalfSpace { normal: unit(*normal).unwrap_or(Vec3::Y), offset: *offset }
                 }
                 Some(NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. }) => Solid::Mesh(mesh.clone()),
                 // Groups, lone triangles and unloaded meshes bound no solid.
@@ -162,7 +166,7 @@ impl CsgTree {
             program.push(Step::Leaf(leaves.len() as u32));
             leaves.push(CsgLeaf {
                 solid,
-                xf: (m != Mat4::IDENTITY).then(|| Xf::new(m)),
+                xf: (m != DMat4::IDENTITY).then(|| Xf::from_f64(m)),
                 material: resolve(material),
                 node: id.unwrap_or(root),
             });

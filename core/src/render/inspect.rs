@@ -2,13 +2,14 @@
 //! hit, the Groups and Transforms on the way, the ray in each space, both normal rules and
 //! the shading terms. Slow and thorough on purpose: it runs for one pixel on a click.
 
-use glam::{Mat4, Vec3};
+use glam::{DMat4, Mat4, Vec3};
 
 use super::compile::CompiledScene;
 use super::shade::{ShadeInfo, shade_hit};
 use super::{NormalTransform, RenderSettings};
 use crate::geometry::Ray;
-use crate::scene::{NodeId, NodeKind, Scene, compose};
+use crate::scene::validate::compose_f64;
+use crate::scene::{NodeId, NodeKind, Scene};
 
 /// One node on the way from the root to the object hit.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,18 +82,19 @@ pub fn inspect_pixel(
             // For a CSG hit, the operand whose surface it is (its path holds the CSG node).
             let node = compiled.hit_node(&hit)?;
             let ids = scene.graph.path_to(node)?;
-            let mut m = Mat4::IDENTITY;
+            // Composed and inverted in f64, as the renderer does, so the story matches it.
+            let mut m = DMat4::IDENTITY;
             let mut path = Vec::with_capacity(ids.len());
             for id in ids {
                 let n = scene.graph.get(id)?;
                 if let NodeKind::Transform(ops) = &n.kind {
-                    m *= compose(ops);
+                    m *= compose_f64(ops);
                 }
                 path.push(PathStep {
                     node: id,
                     kind: n.kind.name(),
-                    world_from_local: m,
-                    ray: world_ray.transformed(&m.inverse()),
+                    world_from_local: m.as_mat4(),
+                    ray: world_ray.transformed(&m.inverse().as_mat4()),
                 });
             }
             let object_ray = path.last().map_or(world_ray, |s| s.ray);

@@ -223,11 +223,48 @@ impl Graph {
             let node = self.node(id);
             let m = node.material.or(inherited);
             out[id.index()] = m;
-            for &c in node.children.iter().rev() {
-                stack.push((c, m));
+            for (c, inherited) in self.list_materials(node, m).into_iter().rev() {
+                stack.push((c, inherited));
             }
         }
         out
+    }
+
+    /// What each child of `node` inherits when it sets no material, given the material `m`
+    /// in effect at `node`. In the file (and in the course's parser) a MaterialIndex holds
+    /// for every later object of its list, so in a Group's or CSG node's list a child
+    /// without one continues the latest one before it, which is what the writer's text says.
+    pub fn list_materials(&self, node: &Node, m: Option<u32>) -> Vec<(NodeId, Option<u32>)> {
+        let listed = matches!(node.kind, NodeKind::Group | NodeKind::Csg(_));
+        let mut running = m;
+        node.children
+            .iter()
+            .map(|&c| {
+                let inherited = running;
+                if listed && let Some(own) = self.get(c).and_then(|n| n.material) {
+                    running = Some(own);
+                }
+                (c, inherited)
+            })
+            .collect()
+    }
+
+    /// The same graph with every material a list continues spelt out, as the parser reads
+    /// the written file: two graphs that differ only in that spelling render alike and
+    /// normalise to equal values.
+    pub fn with_listed_materials(&self) -> Graph {
+        let mut g = self.clone();
+        for id in self.preorder() {
+            if matches!(self.node(id).kind, NodeKind::Group | NodeKind::Csg(_)) {
+                let mut running = None;
+                for &c in &self.node(id).children {
+                    let n = g.node_mut(c);
+                    running = n.material.or(running);
+                    n.material = running;
+                }
+            }
+        }
+        g
     }
 
     /// A copy holding only the nodes reachable from the root, renumbered in preorder. Two

@@ -6,11 +6,13 @@ mod comments;
 mod graph;
 mod mesh;
 mod transform;
+pub mod validate;
 
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, check_closed};
 pub use transform::{TransformOp, compose};
+pub use validate::{Invalid, Place, Problem, check_scene, unit};
 
 use glam::Vec3;
 
@@ -142,5 +144,56 @@ impl Scene {
 
     pub fn lights(&self) -> &[Light] {
         self.lights.as_deref().unwrap_or(&[])
+    }
+}
+
+impl Scene {
+    /// Whether `back` (this scene written and read again) is the same document: the graph
+    /// compacted, every material a list continues spelt out, meshes compared by file name
+    /// (whether one loads depends on the disk, not on the text), comments as the same lines
+    /// (the writer may move one whose field is gone to the end of its block). `Err` names
+    /// the first part that differs.
+    pub fn reads_back_as(&self, back: &Scene) -> Result<(), String> {
+        let (a, a_lines) = self.normalised();
+        let (b, b_lines) = back.normalised();
+        let parts = [
+            ("the camera", a.camera == b.camera),
+            ("the lights", a.lights == b.lights),
+            ("the background", a.background == b.background),
+            ("the materials", a.materials == b.materials),
+            ("the objects", a.graph == b.graph),
+            ("the comments", a_lines == b_lines),
+        ];
+        match parts.iter().find(|(_, same)| !same) {
+            Some((what, _)) => Err(format!("{what} would read back differently")),
+            None => Ok(()),
+        }
+    }
+
+    fn normalised(&self) -> (Scene, Vec<String>) {
+        let mut s = self.clone();
+        let mut lines = Vec::new();
+        let mut take = |c: &mut Comments| lines.extend(std::mem::take(c).lines().cloned());
+        let sc = &mut s.comments;
+        for c in [&mut sc.camera, &mut sc.lights, &mut sc.background, &mut sc.materials] {
+            take(c);
+        }
+        take(&mut Comments { end: std::mem::take(&mut sc.end), ..Comments::default() });
+        for l in s.lights.iter_mut().flatten() {
+            take(&mut l.comments);
+        }
+        for m in &mut s.materials {
+            take(&mut m.comments);
+        }
+        s.graph = s.graph.with_listed_materials().compacted();
+        for id in s.graph.preorder() {
+            let n = s.graph.node_mut(id);
+            take(&mut n.comments);
+            if let NodeKind::TriangleMesh { mesh, .. } = &mut n.kind {
+                *mesh = MeshSlot::Failed(String::new());
+            }
+        }
+        lines.sort();
+        (s, lines)
     }
 }

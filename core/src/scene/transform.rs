@@ -28,7 +28,7 @@ impl TransformOp {
             TransformOp::Rotate { axis, degrees } => {
                 // A deliberate difference from the course parser: the axis is normalised, so
                 // `Rotate { 0 0 2 90 }` is a rotation, not a rotation and a scale.
-                let axis = axis.try_normalize().unwrap_or(Vec3::Z);
+                let axis = super::validate::unit(axis).unwrap_or(Vec3::Z);
                 Mat4::from_axis_angle(axis, degrees.to_radians())
             }
             TransformOp::Matrix(m) => m,
@@ -50,15 +50,20 @@ impl TransformOp {
 
     /// A short human summary, e.g. `Translate(1, 0.5, 0)`.
     pub fn summary(&self) -> String {
-        let v = |v: Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
+        // Very large and very small values in exponent form: 3.4028235e38, not 39 digits.
+        let n = |x: f32| {
+            let a = x.abs();
+            if a.is_finite() && (a >= 1e7 || (a != 0.0 && a < 1e-4)) { format!("{x:e}") } else { format!("{x}") }
+        };
+        let v = |v: Vec3| format!("{}, {}, {}", n(v.x), n(v.y), n(v.z));
         match self {
             TransformOp::Scale(s) => format!("Scale({})", v(*s)),
-            TransformOp::UniformScale(s) => format!("UniformScale({s})"),
+            TransformOp::UniformScale(s) => format!("UniformScale({})", n(*s)),
             TransformOp::Translate(t) => format!("Translate({})", v(*t)),
-            TransformOp::XRotate(d) => format!("XRotate({d}°)"),
-            TransformOp::YRotate(d) => format!("YRotate({d}°)"),
-            TransformOp::ZRotate(d) => format!("ZRotate({d}°)"),
-            TransformOp::Rotate { axis, degrees } => format!("Rotate({}; {degrees}°)", v(*axis)),
+            TransformOp::XRotate(d) => format!("XRotate({}°)", n(*d)),
+            TransformOp::YRotate(d) => format!("YRotate({}°)", n(*d)),
+            TransformOp::ZRotate(d) => format!("ZRotate({}°)", n(*d)),
+            TransformOp::Rotate { axis, degrees } => format!("Rotate({}; {}°)", v(*axis), n(*degrees)),
             TransformOp::Matrix(_) => "Matrix(4×4)".to_string(),
         }
     }
@@ -66,9 +71,10 @@ impl TransformOp {
 
 /// M = op1 · op2 · … · opn: the first op listed is applied last, as nested Transforms would.
 /// (Another deliberate difference from the course code: `Matrix` composes in its listed
-/// position like every other op.)
+/// position like every other op.) Composed in f64 and rounded once, so long chains keep
+/// their precision.
 pub fn compose(ops: &[TransformOp]) -> Mat4 {
-    ops.iter().fold(Mat4::IDENTITY, |m, op| m * op.matrix())
+    super::validate::compose_f64(ops).as_mat4()
 }
 
 #[cfg(test)]

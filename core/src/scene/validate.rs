@@ -1,0 +1,727 @@
+//! The validity rules of a scene, in one place: the parser applies them with file locations,
+//! the editor checks every edit with them before applying it, and the checked writer before
+//! it writes. A scene that passes them is one the writer can print and the parser read back.
+
+use glam::{DMat3, DMat4, DVec3, Vec3};
+
+use super::{Background, Camera, Graph, Light, Material, NodeId, NodeKind, Scene, TransformOp};
+
+/// One broken rule of one item (a camera, a light, a node's own parameters, …).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    /// The field at fault, as the file names it (`radius`, `direction`, `Scale`, …).
+    pub field: String,
+    /// For a Transform: the position of the op at fault.
+    pub op: Option<usize>,
+    pub message: String,
+    /// A state an editor passes through on the way to a valid one (a new TriangleMesh with
+    /// no file chosen yet): allowed in a document, never written.
+    pub incomplete: bool,
+}
+
+impl Invalid {
+    fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Invalid {
+            field: field.into(),
+            op: None,
+            message: message.into(),
+            incomplete: false,
+        }
+    }
+}
+
+impl std::fmt::Display for Invalid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// What a scene-wide problem is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Place {
+    Camera,
+    Light(usize),
+    Background,
+    Material(usize),
+    Node(NodeId),
+}
+
+/// One broken rule somewhere in a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    pub place: Place,
+    pub field: String,
+    pub op: Option<usize>,
+    /// Names the place: `Sphere (node #4): radius must be positive, found -1`.
+    pub message: String,
+    /// The rule alone, to show beside the field: `Sphere: radius must be positive, found -1`.
+    pub reason: String,
+    pub incomplete: bool,
+}
+
+impl Problem {
+    pub fn node(&self) -> Option<NodeId> {
+        match self.place {
+            Place::Node(id) => Some(id),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// `v` at unit length, or `None` for a zero or non-finite vector. Divides by the largest
+/// component first, so vectors whose squared length overflows f32 (`0 0 1e20`) still
+/// normalise to what their direction says.
+pub fn unit(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    if !(m.is_finite() && m > 0.0) {
+        return None;
+    }
+    (v / m).try_normalize()
+}
+
+/// The largest ratio of stretch to squash a linear map may have. f32 keeps about 7 digits;
+/// past a million the object-space ray keeps almost none of them, so the map is as good as
+/// singular.
+const MAX_CONDITION: f64 = 1e6;
+
+fn finite(name: &str, values: &[f32]) -> Result<(), Invalid> {
+    // No value in the message: a number field turns a typed "nan" into +inf, and showing
+    // "inf" to someone who typed "nan" would only puzzle them.
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Invalid::new(
+            name,
+            format!("{name} must be a finite number"),
+        ))
+    }
+}
+
+fn finite3(name: &str, v: Vec3) -> Result<(), Invalid> {
+    finite(name, &v.to_array())
+}
+
+pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
+    let (kw, center, direction, up) = match c {
+        Camera::Orthographic {
+            center,
+            direction,
+            up,
+            ..
+        } => ("OrthographicCamera", center, direction, up),
+        Camera::Perspective {
+            center,
+            direction,
+            up,
+            ..
+        } => ("PerspectiveCamera", center, direction, up),
+    };
+    finite3("center", *center)?;
+    finite3("direction", *direction)?;
+    finite3("up", *up)?;
+    let Some(d) = unit(*direction) else {
+        return Err(Invalid::new(
+            "direction",
+            format!("{kw}: direction must not be zero"),
+        ));
+    };
+    // Unit vectors: the parallel test cannot overflow, whatever the lengths given.
+    match unit(*up) {
+        Some(u) if u.cross(d).length_squared() > 1e-12 => {}
+        _ => {
+            return Err(Invalid::new(
+                "up",
+                format!("{kw}: up must not be zero or parallel to direction"),
+            ));
+        }
+    }
+    match *c {
+        Camera::Perspective { angle, .. } => {
+            finite("angle", &[angle])?;
+            if !(angle > 0.0 && angle < 180.0) {
+                let m = format!(
+                    "PerspectiveCamera: angle must be between 0 and 180 degrees, found {angle}"
+                );
+                return Err(Invalid::new("angle", m));
+            }
+        }
+        Camera::Orthographic { size, .. } => {
+            finite("size", &[size])?;
+            if size <= 0.0 {
+                return Err(Invalid::new(
+                    "size",
+                    format!("OrthographicCamera: size must be positive, found {size}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+pub fn check_light(l: &Light) -> Result<(), Invalid> {
+    finite3("direction", l.direction)?;
+    finite3("color", l.color)?;
+    if unit(l.direction).is_none() {
+        return Err(Invalid::new(
+            "direction",
+            "DirectionalLight: direction must not be zero",
+        ));
+    }
+    Ok(())
+}
+
+pub fn check_background(b: &Background) -> Result<(), Invalid> {
+    if let Some(c) = b.color {
+        finite3("color", c)?;
+    }
+    if let Some(a) = b.ambient {
+        finite3("ambientLight", a)?;
+    }
+    Ok(())
+}
+
+/// A word the lexer reads back as one token: not empty, no ASCII whitespace, braces, `#`
+/// or NUL (the reader refuses files holding one).
+fn is_word(s: &str) -> bool {
+    !s.is_empty()
+        && !s
+            .bytes()
+            .any(|c| c.is_ascii_whitespace() || matches!(c, b'{' | b'}' | b'#' | 0))
+}
+
+pub fn check_material(m: &Material) -> Result<(), Invalid> {
+    finite3("diffuseColor", m.diffuse)?;
+    for (i, (name, values)) in m.extra.iter().enumerate() {
+        // The reader takes a number-like word as a value and `obj_file` as a mesh field.
+        if !is_word(name) || crate::format::is_numberlike(name) || name == "obj_file" {
+            let m = format!(
+                "material field name \"{}\" cannot be written",
+                name.escape_debug()
+            );
+            return Err(Invalid::new(name.clone(), m));
+        }
+        if name == "diffuseColor" || m.extra[..i].iter().any(|(n, _)| n == name) {
+            return Err(Invalid::new(
+                name.clone(),
+                format!("\"{name}\" is given twice in the material"),
+            ));
+        }
+        finite(name, values)?;
+    }
+    Ok(())
+}
+
+/// Why a linear map cannot move rays into object space, if it cannot: zero or overflowing
+/// volume, or a condition number past [`MAX_CONDITION`]. Relative to the map's own scale,
+/// so a uniform scale of 1e-4 or 1e13 is fine and `Scale 1 0 1` is not.
+fn singular(a: DMat3) -> Option<&'static str> {
+    let det = a.determinant();
+    if !det.is_finite() {
+        return Some("overflows");
+    }
+    if det == 0.0 {
+        return Some("flattens space, so rays cannot be moved into object space");
+    }
+    let inv = a.inverse();
+    let norm = |m: DMat3| {
+        (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt()
+    };
+    // Frobenius norms: the identity gives 3, a map squashing one axis by k about 3k.
+    let cond = norm(a) * norm(inv) / 3.0;
+    if !cond.is_finite() || cond > MAX_CONDITION {
+        return Some(
+            "squashes one direction so much more than another that rays lose all precision",
+        );
+    }
+    // The tracer works in f32: both directions of the map must fit in it with room to spare.
+    let fits = |m: DMat3| {
+        m.to_cols_array()
+            .iter()
+            .all(|v| v.abs() < f64::from(f32::MAX) / 16.0)
+    };
+    if !fits(a) || !fits(inv) {
+        return Some("overflows");
+    }
+    None
+}
+
+/// One op on its own: finite numbers, a last Matrix row of 0 0 0 1, a non-zero Rotate axis,
+/// and not singular by itself.
+pub fn check_op(op: &TransformOp) -> Result<(), Invalid> {
+    let name = op.name();
+    match op {
+        TransformOp::Scale(v) | TransformOp::Translate(v) => finite3(name, *v)?,
+        TransformOp::UniformScale(s)
+        | TransformOp::XRotate(s)
+        | TransformOp::YRotate(s)
+        | TransformOp::ZRotate(s) => finite(name, &[*s])?,
+        TransformOp::Rotate { axis, degrees } => {
+            finite(name, &axis.to_array())?;
+            finite(name, &[*degrees])?;
+            if unit(*axis).is_none() {
+                return Err(Invalid::new(name, "Rotate: the axis must not be zero"));
+            }
+        }
+        TransformOp::Matrix(m) => {
+            finite(name, &m.to_cols_array())?;
+            let r = m.row(3);
+            if r != glam::Vec4::W {
+                let m = format!(
+                    "Matrix: the last row must be 0 0 0 1 (a projective matrix cannot move rays), found {} {} {} {}",
+                    r.x, r.y, r.z, r.w
+                );
+                return Err(Invalid::new(name, m));
+            }
+        }
+    }
+    if let Some(why) = singular(DMat3::from_mat4(op_matrix_f64(op))) {
+        return Err(Invalid::new(
+            name,
+            format!("singular transform: {} {why}", op.summary()),
+        ));
+    }
+    Ok(())
+}
+
+/// An op's matrix in f64, so long chains compose without losing precision.
+pub fn op_matrix_f64(op: &TransformOp) -> DMat4 {
+    let d = |v: Vec3| v.as_dvec3();
+    match *op {
+        TransformOp::Scale(s) => DMat4::from_scale(d(s)),
+        TransformOp::UniformScale(s) => DMat4::from_scale(DVec3::splat(f64::from(s))),
+        TransformOp::Translate(t) => DMat4::from_translation(d(t)),
+        TransformOp::XRotate(a) => DMat4::from_rotation_x(f64::from(a).to_radians()),
+        TransformOp::YRotate(a) => DMat4::from_rotation_y(f64::from(a).to_radians()),
+        TransformOp::ZRotate(a) => DMat4::from_rotation_z(f64::from(a).to_radians()),
+        TransformOp::Rotate { axis, degrees } => {
+            // Normalised in f64 after the overflow-safe f32 step, so `0 0 1e20` is z.
+            let axis = unit(axis).unwrap_or(Vec3::Z).as_dvec3().normalize();
+            DMat4::from_axis_angle(axis, f64::from(degrees).to_radians())
+        }
+        TransformOp::Matrix(m) => m.as_dmat4(),
+    }
+}
+
+/// M = op1 · op2 · … · opn in f64.
+pub fn compose_f64(ops: &[TransformOp]) -> DMat4 {
+    ops.iter()
+        .fold(DMat4::IDENTITY, |m, op| m * op_matrix_f64(op))
+}
+
+/// Whether a world-from-object matrix (composed through the whole chain) can be used.
+pub fn check_world_from_object(m: &DMat4) -> Result<(), String> {
+    let why = singular(DMat3::from_mat4(*m)).or_else(|| {
+        (!m.to_cols_array()
+            .iter()
+            .all(|v| v.abs() < f64::from(f32::MAX)))
+        .then_some("overflows")
+    });
+    match why {
+        Some(why) => Err(format!(
+            "singular transform: the combined transforms down to here {why}"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The rules for one node's own parameters.
+pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
+    match kind {
+        NodeKind::Group | NodeKind::Csg(_) => {}
+        NodeKind::Transform(ops) => {
+            for (i, op) in ops.iter().enumerate() {
+                check_op(op).map_err(|e| Invalid { op: Some(i), ..e })?;
+            }
+            if let Some(why) = singular(DMat3::from_mat4(compose_f64(ops))) {
+                return Err(Invalid::new(
+                    "ops",
+                    format!("singular transform: the combined operations {why}"),
+                ));
+            }
+        }
+        NodeKind::Sphere { center, radius } => {
+            finite3("center", *center)?;
+            finite("radius", &[*radius])?;
+            if *radius <= 0.0 {
+                return Err(Invalid::new(
+                    "radius",
+                    format!("Sphere: radius must be positive, found {radius}"),
+                ));
+            }
+        }
+        NodeKind::Plane { normal, offset } => {
+            finite3("normal", *normal)?;
+            finite("offset", &[*offset])?;
+            if unit(*normal).is_none() {
+                return Err(Invalid::new("normal", "Plane: normal must not be zero"));
+            }
+        }
+        NodeKind::Triangle { vertices } => {
+            for (name, v) in ["vertex0", "vertex1", "vertex2"].into_iter().zip(vertices) {
+                finite3(name, *v)?;
+            }
+        }
+        NodeKind::TriangleMesh { obj_file, .. } => {
+            if obj_file.is_empty() {
+                return Err(Invalid {
+                    incomplete: true,
+                    ..Invalid::new("obj_file", "TriangleMesh: no OBJ file chosen yet")
+                });
+            }
+            if !is_word(obj_file) {
+                let m = format!(
+                    "TriangleMesh: \"{}\" cannot be written as a file name (no spaces, braces or #)",
+                    obj_file.escape_debug()
+                );
+                return Err(Invalid::new("obj_file", m));
+            }
+        }
+        NodeKind::Box { min, max } => {
+            finite3("min", *min)?;
+            finite3("max", *max)?;
+            if min.cmpgt(*max).any() {
+                return Err(Invalid::new(
+                    "max",
+                    "Box: min must not exceed max on any axis",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether `id` bounds a solid (a CSG operand): Transforms are followed to what they move.
+pub fn is_solid(graph: &Graph, id: NodeId) -> bool {
+    let mut cur = id;
+    loop {
+        match graph.get(cur).map(|n| (&n.kind, n.children.first())) {
+            Some((NodeKind::Transform(_), Some(&c))) => cur = c,
+            Some((
+                NodeKind::Sphere { .. }
+                | NodeKind::Box { .. }
+                | NodeKind::Plane { .. }
+                | NodeKind::Csg(_)
+                | NodeKind::TriangleMesh { .. },
+                _,
+            )) => return true,
+            _ => return false,
+        }
+    }
+}
+
+/// Rules about the object graph: each node's parameters, Transform and CSG child counts,
+/// CSG operands that are solids, materials in range and placed where the file can say
+/// them, and every Transform's world-from-object matrix composed through its whole chain.
+pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
+    let mut out = Vec::new();
+    let mut stack = vec![(graph.root(), None::<NodeId>)];
+    while let Some((id, parent)) = stack.pop() {
+        let Some(node) = graph.get(id) else { continue };
+        let name = node.kind.name();
+        let mut push = |field: &str, op: Option<usize>, reason: String, incomplete: bool| {
+            // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
+            let rest = reason
+                .strip_prefix(name)
+                .and_then(|r| r.strip_prefix(": "))
+                .unwrap_or(&reason);
+            out.push(Problem {
+                place: Place::Node(id),
+                field: field.to_string(),
+                op,
+                message: format!("{name} (node #{}): {rest}", id.0),
+                reason: reason.clone(),
+                incomplete,
+            })
+        };
+        if let Err(e) = check_kind(&node.kind) {
+            push(&e.field, e.op, e.message, e.incomplete);
+        }
+        if let Some(m) = node.material {
+            let parent_kind = parent.and_then(|p| graph.get(p)).map(|p| &p.kind);
+            if !matches!(parent_kind, Some(NodeKind::Group | NodeKind::Csg(_))) {
+                let m = format!(
+                    "MaterialIndex {m} can only be set on an object listed in a Group or CSG node"
+                );
+                push("material", None, m, false);
+            }
+            if m as usize >= n_materials {
+                let m = format!(
+                    "MaterialIndex {m} is out of range: the scene has {n_materials} material(s)"
+                );
+                push("material", None, m, false);
+            }
+        }
+        match &node.kind {
+            NodeKind::Transform(_) if node.children.len() != 1 => {
+                push(
+                    "children",
+                    None,
+                    "a Transform holds exactly one object".into(),
+                    false,
+                );
+            }
+            NodeKind::Csg(op) => {
+                if node.children.len() != 2 {
+                    push(
+                        "children",
+                        None,
+                        format!("{} needs exactly two operand objects", op.name()),
+                        false,
+                    );
+                }
+                for &c in &node.children {
+                    if !is_solid(graph, c) {
+                        let what = graph.get(c).map_or("?", |n| n.kind.name());
+                        let m = format!(
+                            "a {what} is not a solid, so it cannot be an operand of {}",
+                            op.name()
+                        );
+                        push("children", None, m, false);
+                    }
+                }
+            }
+            _ => {}
+        }
+        for &c in node.children.iter().rev() {
+            stack.push((c, Some(id)));
+        }
+    }
+    out.extend(check_world_chain(graph).into_iter().map(|p| Problem {
+        message: format!(
+            "Transform (node #{}): {}",
+            p.node().map_or(0, |n| n.0),
+            p.message
+        ),
+        ..p
+    }));
+    out
+}
+
+/// Every Transform's world-from-object matrix, composed in f64 through its whole chain of
+/// ancestors. Only the outermost failing Transform of a chain is reported; messages do not
+/// name the node (the parser gives its location instead).
+pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
+    let mut out = Vec::new();
+    let mut stack = vec![(graph.root(), DMat4::IDENTITY)];
+    while let Some((id, mut world)) = stack.pop() {
+        let Some(node) = graph.get(id) else { continue };
+        if let NodeKind::Transform(ops) = &node.kind {
+            world *= compose_f64(ops);
+            if let Err(message) = check_world_from_object(&world) {
+                out.push(Problem {
+                    place: Place::Node(id),
+                    field: "ops".into(),
+                    op: None,
+                    reason: message.clone(),
+                    message,
+                    incomplete: false,
+                });
+                continue;
+            }
+        }
+        for &c in node.children.iter().rev() {
+            stack.push((c, world));
+        }
+    }
+    out
+}
+
+/// Every rule, over the whole scene.
+pub fn check_scene(scene: &Scene) -> Vec<Problem> {
+    let mut out = Vec::new();
+    let mut push = |r: Result<(), Invalid>, place: Place, what: String| {
+        if let Err(e) = r {
+            let message = format!("{what}: {}", e.message);
+            out.push(Problem {
+                place,
+                field: e.field,
+                op: None,
+                message,
+                reason: e.message,
+                incomplete: false,
+            });
+        }
+    };
+    push(check_camera(&scene.camera), Place::Camera, "camera".into());
+    for (i, l) in scene.lights().iter().enumerate() {
+        push(check_light(l), Place::Light(i), format!("light {i}"));
+    }
+    push(
+        check_background(&scene.background),
+        Place::Background,
+        "background".into(),
+    );
+    for (i, m) in scene.materials.iter().enumerate() {
+        push(
+            check_material(m),
+            Place::Material(i),
+            format!("material {i}"),
+        );
+    }
+    out.extend(check_graph(&scene.graph, scene.materials.len()));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{MeshSlot, Node};
+    use super::*;
+    use glam::Mat4;
+
+    fn ts(ops: Vec<TransformOp>) -> Result<(), Invalid> {
+        check_kind(&NodeKind::Transform(ops))
+    }
+
+    #[test]
+    fn unit_survives_components_whose_square_overflows() {
+        assert_eq!(unit(Vec3::new(0.0, 0.0, 1e20)), Some(Vec3::Z));
+        assert_eq!(unit(Vec3::new(0.0, 0.0, -3e38)), Some(Vec3::NEG_Z));
+        let l = Vec3::new(-0.5, -1.0, -0.5);
+        assert!((unit(l * 1e20).expect("unit") - l.normalize()).length() < 1e-6);
+        assert_eq!(unit(Vec3::ZERO), None);
+        assert_eq!(unit(Vec3::new(f32::NAN, 0.0, 1.0)), None);
+    }
+
+    #[test]
+    fn singularity_is_relative_to_the_matrix_s_own_scale() {
+        assert!(ts(vec![TransformOp::UniformScale(0.0001)]).is_ok());
+        assert!(ts(vec![TransformOp::UniformScale(1e13)]).is_ok());
+        assert!(ts(vec![TransformOp::Scale(Vec3::new(1.0, 0.0, 1.0))]).is_err());
+        assert!(ts(vec![TransformOp::Scale(Vec3::new(1.0, 1e-8, 1.0))]).is_err());
+        assert!(ts(vec![TransformOp::UniformScale(0.0)]).is_err());
+        let e = ts(vec![
+            TransformOp::Translate(Vec3::X),
+            TransformOp::Scale(Vec3::new(1.0, 0.0, 1.0)),
+        ])
+        .expect_err("flat");
+        assert_eq!((e.field.as_str(), e.op), ("Scale", Some(1)));
+    }
+
+    #[test]
+    fn a_projective_matrix_and_a_zero_rotate_axis_are_errors() {
+        let mut m = Mat4::IDENTITY.to_cols_array_2d();
+        m[0][3] = 0.5; // row 3, column 0
+        let e =
+            check_op(&TransformOp::Matrix(Mat4::from_cols_array_2d(&m))).expect_err("projective");
+        assert!(e.message.contains("last row must be 0 0 0 1"), "{e}");
+        let e = check_op(&TransformOp::Rotate {
+            axis: Vec3::ZERO,
+            degrees: 45.0,
+        })
+        .expect_err("zero axis");
+        assert!(e.message.contains("axis must not be zero"), "{e}");
+    }
+
+    #[test]
+    fn camera_rules_use_unit_vectors_and_name_their_field() {
+        let cam = |direction: Vec3, up: Vec3, size: f32| Camera::Orthographic {
+            center: Vec3::ZERO,
+            direction,
+            up,
+            size,
+        };
+        assert!(check_camera(&cam(Vec3::new(0.0, 0.0, -3e38), Vec3::Y, 1.0)).is_ok());
+        assert_eq!(
+            check_camera(&cam(Vec3::Y * 2.0, Vec3::Y, 1.0))
+                .expect_err("parallel")
+                .field,
+            "up"
+        );
+        assert_eq!(
+            check_camera(&cam(Vec3::NEG_Z, Vec3::Y, 0.0))
+                .expect_err("size 0")
+                .field,
+            "size"
+        );
+        assert_eq!(
+            check_camera(&cam(Vec3::NEG_Z, Vec3::Y, f32::NAN))
+                .expect_err("nan")
+                .field,
+            "size"
+        );
+    }
+
+    #[test]
+    fn negative_radius_and_empty_mesh_file_differ_in_kind() {
+        let e = check_kind(&NodeKind::Sphere {
+            center: Vec3::ZERO,
+            radius: -1.0,
+        })
+        .expect_err("negative");
+        assert!(
+            !e.incomplete,
+            "a negative radius is invalid, not incomplete"
+        );
+        let mesh = |f: &str| NodeKind::TriangleMesh {
+            obj_file: f.into(),
+            mesh: MeshSlot::Failed(String::new()),
+        };
+        assert!(check_kind(&mesh("")).expect_err("no file").incomplete);
+        assert!(!check_kind(&mesh("a b.obj")).expect_err("space").incomplete);
+        assert!(
+            check_kind(&mesh("1.obj")).is_ok(),
+            "the reader takes any word after obj_file"
+        );
+    }
+
+    #[test]
+    fn material_field_names_must_read_back_as_fields() {
+        let with = |name: &str| Material {
+            extra: vec![(name.into(), vec![1.0])],
+            ..Material::diffuse(Vec3::ONE)
+        };
+        assert!(check_material(&with("exponent")).is_ok());
+        for bad in [
+            "",
+            "2x",
+            "-e",
+            "nan",
+            "obj_file",
+            "diffuseColor",
+            "a b",
+            "x}",
+        ] {
+            assert!(check_material(&with(bad)).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn nested_tiny_scales_are_fine_and_a_flattening_one_is_found_in_the_chain() {
+        let mut g = Graph::new();
+        let mut parent = g.root();
+        for _ in 0..10 {
+            let t = g.add(Node::new(NodeKind::Transform(vec![
+                TransformOp::UniformScale(0.1),
+            ])));
+            g.push_child(parent, t);
+            parent = t;
+        }
+        let s = g.add(Node::new(NodeKind::Sphere {
+            center: Vec3::ZERO,
+            radius: 1e10,
+        }));
+        g.push_child(parent, s);
+        assert_eq!(check_graph(&g, 0), []);
+        // Two ops, each fine alone, that squash y by 1e-8 together.
+        let mut g = Graph::new();
+        let ops = vec![TransformOp::Scale(Vec3::new(1.0, 1e-4, 1.0))];
+        let a = g.add(Node::new(NodeKind::Transform(ops.clone())));
+        let b = g.add(Node::new(NodeKind::Transform(ops)));
+        let s = g.add(Node::new(NodeKind::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        }));
+        g.push_child(g.root(), a);
+        g.push_child(a, b);
+        g.push_child(b, s);
+        let p = check_graph(&g, 0);
+        assert_eq!(p.len(), 1, "{p:?}");
+        assert_eq!(p[0].place, Place::Node(b));
+    }
+}
