@@ -72,8 +72,10 @@ pub fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
             name_widget(&r, format!("{name} {axis}"), f64::from(*c));
             changed |= r.changed();
         }
-        refusal_note(ui, name);
     });
+    // Under the row, not beside it: the row's width is taken, and a wrapped reason one word
+    // a line is hard to read.
+    refusal_note(ui, name);
     changed
 }
 
@@ -86,14 +88,15 @@ fn name_widget(r: &egui::Response, name: String, value: f64) {
 }
 
 fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
-    ui.horizontal(|ui| {
+    let changed = ui.horizontal(|ui| {
         ui.label(name);
         let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
         name_widget(&r, name.to_string(), f64::from(*v));
-        refusal_note(ui, name);
         r.changed()
     })
-    .inner
+    .inner;
+    refusal_note(ui, name);
+    changed
 }
 
 /// What the last refused edit said, while the inspector draws the place it was about. In
@@ -140,13 +143,13 @@ fn same_field(label: &str, field: &str) -> bool {
 fn refusal_note(ui: &mut egui::Ui, label: &str) {
     let (note, op) = ui.data(|d| (d.get_temp::<Option<Note>>(note_id()).flatten(), d.get_temp::<Option<usize>>(op_id()).flatten()));
     if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
-        // Wrapped in what is left of the row: a long reason must not widen the panel.
+        // Wrapped to the panel: a long reason must not widen it.
         ui.add(egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color)).wrap());
     }
 }
 
 fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
-    ui.horizontal(|ui| {
+    let changed = ui.horizontal(|ui| {
         ui.label(name);
         let mut rgb = c.to_array();
         let changed = ui.color_edit_button_rgb(&mut rgb).changed();
@@ -162,10 +165,11 @@ fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
                 .changed();
         }
         *c = Vec3::from_array(rgb);
-        refusal_note(ui, name);
         changed || changed2
     })
-    .inner
+    .inner;
+    refusal_note(ui, name);
+    changed
 }
 
 fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
