@@ -8,19 +8,15 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use tracelab::app::{AppOptions, TracelabApp};
 
-mod common;
-use common::skip_note;
 
 /// Snapshots are only comparable on the pinned backend (lavapipe via Vulkan): other
-/// backends differ in a few pixels. `.ci/run` pins it; elsewhere these tests skip, saying so.
-fn pinned_backend() -> bool {
-    let ok = std::env::var("WGPU_BACKEND").is_ok_and(|b| b == "vulkan");
-    if !ok {
-        skip_note(
-            "SKIPPED: set WGPU_BACKEND=vulkan and VK_DRIVER_FILES to lavapipe (see .ci/run) to compare snapshots",
-        );
-    }
-    ok
+/// backends differ in a few pixels. `.ci/run` pins it; these tests are `#[ignore]`d so a
+/// plain `cargo test` lists them, and fail here when run without it.
+fn require_pinned_backend() {
+    assert!(
+        std::env::var("WGPU_BACKEND").is_ok_and(|b| b == "vulkan"),
+        "set WGPU_BACKEND=vulkan and VK_DRIVER_FILES to lavapipe (see .ci/run) to compare snapshots"
+    );
 }
 
 fn settled_harness() -> Harness<'static, TracelabApp> {
@@ -56,19 +52,17 @@ fn settled_harness() -> Harness<'static, TracelabApp> {
 }
 
 #[test]
+#[ignore = "needs lavapipe (WGPU_BACKEND=vulkan, VK_DRIVER_FILES): run with --include-ignored, as .ci/run does"]
 fn main_window_on_the_default_scene() {
-    if !pinned_backend() {
-        return;
-    }
+    require_pinned_backend();
     let mut h = settled_harness();
     h.snapshot("main_window");
 }
 
 #[test]
+#[ignore = "needs lavapipe (WGPU_BACKEND=vulkan, VK_DRIVER_FILES): run with --include-ignored, as .ci/run does"]
 fn pixel_inspector_open() {
-    if !pinned_backend() {
-        return;
-    }
+    require_pinned_backend();
     let mut h = settled_harness();
     // A pixel on the squashed yellow sphere at the bottom of the stack.
     h.state_mut().inspect(0, 170, 150);
