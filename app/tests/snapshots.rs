@@ -6,7 +6,7 @@
 use std::time::{Duration, Instant};
 
 use egui_kittest::Harness;
-use tracelab::app::{AppOptions, TracelabApp};
+use tracelab::gui::{AppOptions, TracelabApp};
 
 mod common;
 use common::skip_note;

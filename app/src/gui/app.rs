@@ -8,17 +8,18 @@ use std::time::{Duration, Instant};
 use tracelab_core::Scene;
 use tracelab_core::render::RayStory;
 
-use crate::edit::Edit;
-use crate::loading::{LoadPurpose, Loading};
+use crate::document::edit::Edit;
+use crate::gui::loading::{LoadPurpose, Loading};
 use crate::render_worker::RenderWorker;
-use crate::state::{Document, SceneRead, Selection, read_scene_file};
-use crate::ui::file_dialog::{FileDialog, Purpose};
-use crate::ui::layout::Layout;
-use crate::ui::native_dialog::{Answer, NativeDialog};
-use crate::ui::pixel_inspector::Inspected;
-use crate::ui::tree::TreeRow;
-use crate::ui::viewport::{Compare, Tab, ViewSettings, Viewport};
-use crate::ui::{inspector, pixel_inspector, status, tree};
+use crate::document::{Document, Selection};
+use crate::io::{SceneRead, read_scene_file};
+use crate::gui::file_dialog::{FileDialog, Purpose};
+use crate::gui::layout::Layout;
+use crate::gui::native_dialog::{Answer, NativeDialog};
+use crate::gui::panels::pixel_inspector::Inspected;
+use crate::gui::panels::tree::TreeRow;
+use crate::gui::panels::viewport::{Compare, Tab, ViewSettings, Viewport};
+use crate::gui::panels::{inspector, pixel_inspector, status, tree};
 
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -424,7 +425,7 @@ impl TracelabApp {
     }
 
     /// The images the view drew in the last frame, with the pixels on screen.
-    pub fn shown(&self) -> Vec<crate::ui::viewport::Shown> {
+    pub fn shown(&self) -> Vec<crate::gui::panels::viewport::Shown> {
         self.viewport.shown()
     }
 
@@ -580,7 +581,7 @@ impl TracelabApp {
 
     fn messages(&mut self, ui: &mut egui::Ui) {
         if let Some(l) = &self.loading
-            && crate::ui::loading::ui(ui, l)
+            && crate::gui::panels::loading::ui(ui, l)
         {
             self.cancel_loading();
         }
@@ -948,7 +949,7 @@ impl eframe::App for TracelabApp {
 }
 
 /// Opens the window (the `tracelab` command with no subcommand).
-pub fn run(scene: Option<PathBuf>) -> Result<(), String> {
+pub fn run(scene: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 800.0])
@@ -970,5 +971,5 @@ pub fn run(scene: Option<PathBuf>) -> Result<(), String> {
             )))
         }),
     )
-    .map_err(|e| format!("cannot open the window: {e}"))
+    .map_err(|e| anyhow::anyhow!("cannot open the window: {e}"))
 }

@@ -5,9 +5,9 @@ use egui::DragValue;
 use glam::{Mat4, Vec3};
 use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp};
 
-use crate::edit::{Edit, Refusal};
-use crate::state::{Document, Selection};
-use crate::ui::drag_speed::{DragSpeeds, world_per_unit};
+use crate::document::edit::{Edit, Refusal};
+use crate::document::{Document, Selection};
+use crate::gui::drag_speed::{DragSpeeds, world_per_unit};
 
 pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
     let mut edits = Vec::new();

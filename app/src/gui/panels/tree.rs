@@ -4,8 +4,8 @@
 use glam::Vec3;
 use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 
-use crate::edit::Edit;
-use crate::state::{Document, Selection};
+use crate::document::edit::Edit;
+use crate::document::{Document, Selection};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreeRow {
@@ -196,7 +196,7 @@ fn camera_label(scene: &Scene) -> String {
 
 fn swatch(ui: &mut egui::Ui, c: Vec3) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(10.0, 10.0), egui::Sense::hover());
-    ui.painter().rect_filled(rect, 2.0, crate::ui::color32(c));
+    ui.painter().rect_filled(rect, 2.0, crate::gui::widgets::color32(c));
 }
 
 /// The Group new objects go into: the selected Group, or the Group holding the selection.
