@@ -1,11 +1,12 @@
 //! The course's own `raytracer` command line, flag for flag.
 
-use std::ffi::{OsStr, OsString};
+use std::ffi::OsString;
 use std::path::PathBuf;
 
 use tracelab_core::NormalTransform;
 
 use super::render::RenderJob;
+use super::values::{parse_f32, parse_u32};
 use crate::exit::usage;
 
 /// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
@@ -61,18 +62,3 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     }
     Ok(job)
 }
-
-pub(super) fn parse_f32(s: &OsStr, what: &str) -> anyhow::Result<f32> {
-    s.to_str()
-        .and_then(|t| t.parse::<f32>().ok())
-        .filter(|v| v.is_finite())
-        .ok_or_else(|| usage(format!("{what}: expected a number, found \"{}\"", s.display())))
-}
-
-fn parse_u32(s: &OsStr, what: &str) -> anyhow::Result<u32> {
-    s.to_str()
-        .and_then(|t| t.parse::<u32>().ok())
-        .filter(|&v| v > 0)
-        .ok_or_else(|| usage(format!("{what}: expected a positive whole number, found \"{}\"", s.display())))
-}
-

@@ -7,6 +7,7 @@
 mod course;
 mod fmt;
 mod render;
+mod values;
 
 use std::ffi::OsString;
 use std::io::Write;

@@ -12,7 +12,7 @@ use clap::ValueEnum;
 use tracelab_core::render::{SharedFrame, render_full};
 use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, View};
 
-use super::course::parse_f32;
+use super::values::parse_f32;
 use crate::exit::{check_size, usage};
 use crate::io::load_scene;
 
