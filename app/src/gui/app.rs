@@ -15,10 +15,11 @@ use crate::document::{Document, Selection};
 use crate::io::{SceneRead, read_scene_file};
 use crate::gui::file_dialog::{FileDialog, Purpose};
 use crate::gui::layout::Layout;
+use crate::gui::settings::Settings;
 use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
-use crate::gui::panels::viewport::{Compare, Tab, ViewSettings, Viewport};
+use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
 use crate::gui::panels::{inspector, pixel_inspector, status, tree};
 
 #[derive(Clone, Debug, Default)]
@@ -136,33 +137,31 @@ impl TracelabApp {
     }
 
     pub fn load_persisted(&mut self, s: &dyn eframe::Storage) {
-        if let Some(r) = s.get_string("recent") {
-            self.recent = r
-                .lines()
-                .filter(|l| !l.is_empty())
-                .map(PathBuf::from)
-                .collect();
+        if let Some(settings) = Settings::load(s) {
+            self.apply_settings(settings);
         }
-        if let Some(v) = s.get_string("view") {
-            let mut it = v.split(' ');
-            let mut next = || it.next().unwrap_or("");
-            self.view.tab = match next() {
-                "normals" => Tab::Normals,
-                "depth" => Tab::Depth,
-                "all" => Tab::All,
-                _ => Tab::Color,
-            };
-            self.view.shade_back = next() == "1";
-            if let (Ok(a), Ok(b)) = (next().parse::<f32>(), next().parse::<f32>())
-                && a.is_finite()
-                && b.is_finite()
-            {
-                self.view.depth = (a, b);
-            }
+    }
+
+    /// What is kept between runs (see [`Settings`]).
+    pub fn settings(&self) -> Settings {
+        Settings {
+            recent: self.recent.clone(),
+            tab: self.view.tab,
+            shade_back: self.view.shade_back,
+            depth: self.view.depth,
+            layout_epoch: self.layout.epoch,
         }
-        if let Some(e) = s.get_string("layout").and_then(|l| l.trim().parse().ok()) {
-            self.layout.epoch = e;
+    }
+
+    fn apply_settings(&mut self, s: Settings) {
+        let Settings { recent, tab, shade_back, depth, layout_epoch } = s;
+        self.recent = recent;
+        self.view.tab = tab;
+        self.view.shade_back = shade_back;
+        if depth.0.is_finite() && depth.1.is_finite() {
+            self.view.depth = depth;
         }
+        self.layout.epoch = layout_epoch;
     }
 
     /// Applies an edit through the document (the one place that records undo).
@@ -923,28 +922,7 @@ impl eframe::App for TracelabApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        let recent: Vec<String> = self
-            .recent
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect();
-        storage.set_string("recent", recent.join("\n"));
-        let tab = match self.view.tab {
-            Tab::Color => "color",
-            Tab::Normals => "normals",
-            Tab::Depth => "depth",
-            Tab::All => "all",
-        };
-        storage.set_string(
-            "view",
-            format!(
-                "{tab} {} {} {}",
-                u8::from(self.view.shade_back),
-                self.view.depth.0,
-                self.view.depth.1
-            ),
-        );
-        storage.set_string("layout", self.layout.epoch.to_string());
+        self.settings().save(storage);
     }
 }
 

@@ -8,6 +8,7 @@ pub mod layout;
 pub mod loading;
 pub mod native_dialog;
 pub mod panels;
+pub mod settings;
 pub mod widgets;
 
 pub use app::{AppOptions, Pending, TracelabApp, run};
