@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use tracelab_core::{MeshCache, NodeId, Problem, Scene, check_scene};
+use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check_scene};
 
 pub mod edit;
 
@@ -211,6 +211,32 @@ impl Document {
         self.gesture = None;
         self.generation += 1;
         self.fix_selection();
+    }
+
+    /// Selects something (or nothing); a selection that points at nothing in the scene is
+    /// dropped. The one way the app and the panels change the selection.
+    pub fn select(&mut self, selection: Option<Selection>) {
+        self.selection = selection;
+        self.fix_selection();
+    }
+
+    /// Sets a TriangleMesh's `obj_file` and (re)reads that file from disk, as one edit: the
+    /// mesh is read again even when the name is unchanged (the file may have changed), and
+    /// a file that does not load leaves the node with the error. Relative names resolve from
+    /// the document's folder.
+    pub fn load_mesh(&mut self, node: NodeId, obj_file: String) -> Result<(), Refusal> {
+        let base = self.path.as_deref().and_then(Path::parent);
+        let mesh = match tracelab_core::format::obj::resolve_obj_path(&obj_file, base) {
+            Ok(p) => {
+                self.mesh_cache.forget(&p);
+                match self.mesh_cache.load(&p) {
+                    Ok(m) => MeshSlot::Loaded(m),
+                    Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
+                }
+            }
+            Err(e) => MeshSlot::Failed(e),
+        };
+        self.apply(Edit::SetNodeKind { node, kind: NodeKind::TriangleMesh { obj_file, mesh } })
     }
 
     /// Drops a selection that no longer points at anything.

@@ -2,10 +2,12 @@
 //! worker together.
 
 pub mod app;
+pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
 pub mod layout;
 pub mod loading;
+pub mod menu;
 pub mod native_dialog;
 pub mod panels;
 pub mod settings;
