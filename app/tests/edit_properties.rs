@@ -7,8 +7,8 @@
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
-use tracelab::edit::Edit;
-use tracelab::state::Document;
+use tracelab::document::edit::Edit;
+use tracelab::document::Document;
 use tracelab_core::{
     Background, Camera, CsgOp, Light, Material, MeshCache, MeshSlot, NodeId, NodeKind, RenderSettings, Scene,
     TransformOp, check_scene, compile, parse_scene, render_frame, write_scene,

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
 use glam::Vec3;
-use tracelab::app::{AppOptions, Pending, TracelabApp};
-use tracelab::state::Selection;
+use tracelab::gui::{AppOptions, Pending, TracelabApp};
+use tracelab::document::Selection;
 use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
 
 
@@ -94,7 +94,7 @@ fn edit_save_undo(scene: PathBuf) {
     let original = h.state().doc.scene.clone();
     let (id, t) = translate_transform(h.state());
 
-    let label = tracelab::ui::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    let label = tracelab::gui::panels::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
     h.get_all_by_label_contains(&label)
         .next()
         .expect("tree row")
@@ -208,7 +208,7 @@ fn normals_both_ways(op: &str, tag: &str) -> (Vec<u8>, Vec<u8>) {
     let path = temp_dir(tag).join("sphere.txt");
     std::fs::write(&path, SPHERE_SCENE.replace("OP", op)).expect("write");
     let mut h = harness(Some(path), (40, 40));
-    h.state_mut().view.tab = tracelab::ui::viewport::Tab::Normals;
+    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::Normals;
     settle(&mut h);
     let grab = |h: &Harness<'static, TracelabApp>| {
         h.state().worker.with_published(|p| {
@@ -242,7 +242,7 @@ fn closing_with_unsaved_changes_asks_first() {
     let mut h = harness(None, (32, 32));
     settle(&mut h);
     let (id, t) = translate_transform(h.state());
-    h.state_mut().apply(tracelab::edit::Edit::SetTransformOp {
+    h.state_mut().apply(tracelab::document::edit::Edit::SetTransformOp {
         node: id,
         index: 0,
         op: TransformOp::Translate(t + Vec3::X),
@@ -314,21 +314,21 @@ fn recent_files_and_view_settings_persist() {
     }
     let mut a = TracelabApp::new(None, AppOptions::default());
     assert!(a.open_now(&repo("scenes/hierarchy.txt")));
-    a.view.tab = tracelab::ui::viewport::Tab::Depth;
+    a.view.tab = tracelab::gui::panels::viewport::Tab::Depth;
     a.view.depth = (3.0, 12.5);
     let mut m = Mem(Default::default());
     eframe::App::save(&mut a, &mut m);
     let mut b = TracelabApp::new(None, AppOptions::default());
     b.load_persisted(&m);
     assert_eq!(b.recent, vec![repo("scenes/hierarchy.txt")]);
-    assert_eq!(b.view.tab, tracelab::ui::viewport::Tab::Depth);
+    assert_eq!(b.view.tab, tracelab::gui::panels::viewport::Tab::Depth);
     assert_eq!(b.view.depth, (3.0, 12.5));
 }
 
 #[test]
 fn export_all_three_writes_every_view() {
     let mut h = harness(None, (32, 24));
-    h.state_mut().view.tab = tracelab::ui::viewport::Tab::All;
+    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::All;
     settle(&mut h);
     let out = temp_dir("export").join("shot.png");
     let files = h.state_mut().export(&out).expect("exports");
@@ -404,7 +404,7 @@ fn a_scene_dropped_on_the_window_opens() {
 fn opening_over_unsaved_changes_asks_and_discard_opens() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(
+    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(
         tracelab_core::Material::diffuse(Vec3::ONE),
     ));
     let target = repo("scenes/hierarchy.txt");
@@ -629,7 +629,7 @@ fn the_pixel_inspector_retraces_its_pixel_after_an_edit_and_keeps_the_selection(
     let before = inspected_hit(h.state()).expect("the centre pixel hits the sphere");
     let (id, _) = translate_transform(h.state());
     h.state_mut().doc.selection = Some(Selection::Node(id));
-    h.state_mut().apply(tracelab::edit::Edit::SetTransformOp {
+    h.state_mut().apply(tracelab::document::edit::Edit::SetTransformOp {
         node: id,
         index: 0,
         op: TransformOp::Translate(Vec3::new(0.3, 0.2, 0.5)),
@@ -663,7 +663,7 @@ fn the_pixel_inspector_forgets_a_deleted_box() {
     }
     let hit = inspected_hit(h.state()).expect("the centre pixel shows the box");
     let _ = h.get_by_label_contains("Hit Box");
-    h.state_mut().apply(tracelab::edit::Edit::DeleteNode { node: hit.node });
+    h.state_mut().apply(tracelab::document::edit::Edit::DeleteNode { node: hit.node });
     settle(&mut h);
     for _ in 0..3 {
         h.step();
@@ -729,7 +729,7 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     if let NodeKind::TriangleMesh { obj_file, .. } = &mut kind {
         *obj_file = cube.clone();
     }
-    h.state_mut().apply(tracelab::edit::Edit::SetNodeKind { node: id, kind });
+    h.state_mut().apply(tracelab::document::edit::Edit::SetNodeKind { node: id, kind });
     h.step();
     h.step();
     assert_eq!(obj_field(&h), cube);
@@ -824,7 +824,7 @@ fn a_large_scene_given_at_start_does_not_hold_up_the_first_frame() {
 fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
     let edited = h.state().doc.scene.clone();
     let bad = temp_dir("bad-dirty").join("broken.txt");
     std::fs::write(&bad, "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 oops\n}\n").expect("write");
@@ -884,8 +884,8 @@ fn the_file_dialog_lists_scene_files_and_folders_only() {
     std::fs::create_dir_all(d.join("sub")).expect("mkdir");
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().dialog = Some(tracelab::ui::file_dialog::FileDialog::new(
-        tracelab::ui::file_dialog::Purpose::Open,
+    h.state_mut().dialog = Some(tracelab::gui::file_dialog::FileDialog::new(
+        tracelab::gui::file_dialog::Purpose::Open,
         Some(&d.join("a.txt")),
     ));
     for _ in 0..3 {
@@ -900,8 +900,8 @@ fn the_file_dialog_lists_scene_files_and_folders_only() {
 fn the_file_dialog_never_shows_the_folder_as_a_dot() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().dialog = Some(tracelab::ui::file_dialog::FileDialog::new(
-        tracelab::ui::file_dialog::Purpose::Open,
+    h.state_mut().dialog = Some(tracelab::gui::file_dialog::FileDialog::new(
+        tracelab::gui::file_dialog::Purpose::Open,
         Some(Path::new("scene.txt")),
     ));
     for _ in 0..3 {
@@ -916,7 +916,7 @@ fn the_file_dialog_never_shows_the_folder_as_a_dot() {
 fn file_new_asks_about_unsaved_changes_then_starts_an_untitled_scene() {
     let mut h = harness(Some(repo("scenes/hierarchy.txt")), (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
     h.get_by_label("File").click();
     h.step();
     h.step();
@@ -931,14 +931,14 @@ fn file_new_asks_about_unsaved_changes_then_starts_an_untitled_scene() {
     }
     assert_eq!(h.state().doc.path, None);
     assert!(!h.state().doc.is_dirty());
-    assert_eq!(h.state().doc.scene, tracelab::state::Document::builtin().scene);
+    assert_eq!(h.state().doc.scene, tracelab::document::Document::builtin().scene);
 }
 
 #[test]
 fn ctrl_q_quits_asking_first_about_unsaved_changes() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
     for _ in 0..3 {
         h.step();
@@ -1145,7 +1145,7 @@ fn save_says_which_comments_it_would_drop_before_writing() {
     std::fs::write(&path, &text).expect("write");
     let mut h = harness(Some(path.clone()), (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     for _ in 0..3 {
         h.step();
@@ -1293,7 +1293,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
     assert!(msg.contains("not saved") && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)), "{msg}");
     // The explanation is on screen, and the tree shows the node in red (its row has an error).
     let _ = h.get_by_label_contains("not saved; first fix");
-    let rows = tracelab::ui::tree::tree_rows(&h.state().doc.scene);
+    let rows = tracelab::gui::panels::tree::tree_rows(&h.state().doc.scene);
     assert!(rows.iter().any(|r| r.id == mesh && r.error.is_some()));
     assert!(h.state().doc.is_dirty(), "nothing was saved");
 }

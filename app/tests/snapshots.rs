@@ -6,7 +6,7 @@
 use std::time::{Duration, Instant};
 
 use egui_kittest::Harness;
-use tracelab::app::{AppOptions, TracelabApp};
+use tracelab::gui::{AppOptions, TracelabApp};
 
 
 /// Snapshots are only comparable on the pinned backend (lavapipe via Vulkan): other

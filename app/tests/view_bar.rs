@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use tracelab::app::{AppOptions, TracelabApp};
-use tracelab::ui::viewport::Shown;
+use tracelab::gui::{AppOptions, TracelabApp};
+use tracelab::gui::panels::viewport::Shown;
 
 /// Scaled in y only and turned, so the two normal rules differ visibly.
 const SQUASHED: &str = "

@@ -1,40 +1,23 @@
 //! `tracelab bench`: closest-hit throughput for one primary ray per pixel, as
-//! `../shared/perf/embree_bench.cpp` measures Embree (same rays, same checksums); and
-//! `tracelab bench-progressive`: how long the GUI waits after a change for its first coarse
-//! image and for the full colour+normal+depth frame.
+//! `../shared/perf/embree_bench.cpp` measures Embree (same rays, same checksums).
 
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rayon::prelude::*;
 use tracelab_core::accel::TriangleBvh;
 use tracelab_core::geometry::Ray;
-use tracelab_core::render::SharedFrame;
-use tracelab_core::{
-    CompiledScene, Mesh, MeshSlot, NodeKind, NormalTransform, RenderSettings, Scene,
-    render_progressive,
-};
+use tracelab_core::{CompiledScene, Mesh, MeshSlot, NodeKind, Scene};
 
-use crate::cli::{BenchArgs, CliError, ProgressiveArgs, check_size, load};
+use super::{BenchArgs, median};
+use crate::exit::check_size;
+use crate::io::load_scene;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-/// `println!` that checks the write (a full disk is an error, a closed pipe ends the run).
-macro_rules! out {
-    ($($arg:tt)*) => {
-        crate::cli::write_stdout(format!("{}\n", format_args!($($arg)*)).as_bytes())?
-    };
-}
-
-pub fn run(b: &BenchArgs) -> Result<(), CliError> {
+pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
     let (w, h) = (b.size[0], b.size[1]);
     check_size(w, h)?;
     let t_load = Instant::now();
-    let scene = load(Some(&b.scene))?;
+    let scene = load_scene(Some(&b.scene))?;
     let load_ms = t_load.elapsed().as_secs_f64() * 1e3;
     out!(
         "load: {load_ms:.1} ms for the scene, its OBJ files and their BVHs, {} threads",
@@ -189,43 +172,3 @@ fn distinct_meshes(scene: &Scene) -> Vec<Arc<Mesh>> {
     meshes
 }
 
-/// From "the scene changed" (compile the loaded scene) to the first complete coarse pass and
-/// to the last, full-resolution pass of the progressive renderer, as the GUI drives it.
-pub fn run_progressive(b: &ProgressiveArgs) -> Result<(), CliError> {
-    let (w, h) = (b.size[0], b.size[1]);
-    check_size(w, h)?;
-    let scene = load(Some(&b.scene))?;
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        shade_back: false,
-        normal_transform: NormalTransform::Correct,
-    };
-    let target = SharedFrame::new();
-    let never = AtomicBool::new(false);
-    let once = || {
-        let start = Instant::now();
-        let compiled = CompiledScene::new(&scene);
-        let mut coarse = None;
-        let mut full = Duration::ZERO;
-        let _ = render_progressive(&compiled, &settings, &target, &never, |_| {
-            coarse.get_or_insert(start.elapsed());
-            full = start.elapsed();
-        });
-        (
-            coarse.unwrap_or(full).as_secs_f64() * 1e3,
-            full.as_secs_f64() * 1e3,
-        )
-    };
-    once(); // warm-up
-    let runs: Vec<(f64, f64)> = (0..b.repeat.max(1)).map(|_| once()).collect();
-    let coarse = median(runs.iter().map(|r| r.0).collect());
-    let full = median(runs.iter().map(|r| r.1).collect());
-    out!(
-        "frame: {w}x{h}, {} threads, medians of {}",
-        rayon::current_num_threads(),
-        runs.len()
-    );
-    out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
-    Ok(())
-}

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
-use crate::ui::file_dialog::Purpose;
+use crate::gui::file_dialog::Purpose;
 
 /// A native dialog that answers "nothing chosen" faster than a person can is taken for a
 /// desktop without one (the portal backend returns at once and silently where there is none).

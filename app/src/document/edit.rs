@@ -1,4 +1,4 @@
-//! Edits as commands. Panels emit them; [`crate::state::Document::apply`] is the one place
+//! Edits as commands. Panels emit them; [`crate::document::Document::apply`] is the one place
 //! that carries them out (through [`apply_to`]) and records undo.
 
 use glam::Vec3;

@@ -7,7 +7,7 @@ use tracelab_core::{NormalTransform, RenderSettings, View};
 
 use crate::render_worker::{Published, RenderWorker};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Tab {
     Color,
     Normals,

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use tracelab_core::{MeshCache, MeshEvent};
 
-use crate::state::{SceneRead, read_scene_file};
+use crate::io::{SceneRead, read_scene_file};
 
 /// Why a file is being read: what to do with it when it arrives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

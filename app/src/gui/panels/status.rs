@@ -2,7 +2,7 @@
 //! triangles, nodes), messages.
 
 use crate::render_worker::RenderWorker;
-use crate::state::Document;
+use crate::document::Document;
 
 pub fn ui(
     ui: &mut egui::Ui,

@@ -1,16 +1,19 @@
 //! The inspector (right panel): every parameter of the selection, as widgets that emit
-//! [`Edit`]s. Widgets edit copies; nothing here changes the document directly.
+//! [`Edit`]s (and, for a TriangleMesh's file, [`AppCommand::LoadMesh`]). Widgets edit copies;
+//! nothing here changes the document or reads files.
 
 use egui::DragValue;
 use glam::{Mat4, Vec3};
 use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp};
 
-use crate::edit::{Edit, Refusal};
-use crate::state::{Document, Selection};
-use crate::ui::drag_speed::{DragSpeeds, world_per_unit};
+use crate::document::edit::{Edit, Refusal};
+use crate::document::{Document, Selection};
+use crate::gui::command::AppCommand;
+use crate::gui::drag_speed::{DragSpeeds, world_per_unit};
 
-pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
+pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
     let mut edits = Vec::new();
+    let mut asked = Vec::new();
     let place = match doc.selection {
         Some(Selection::Camera) => Some(Place::Camera),
         Some(Selection::Background) => Some(Place::Background),
@@ -57,9 +60,9 @@ pub fn ui(ui: &mut egui::Ui, doc: &mut Document) -> Vec<Edit> {
                 ui.heading(format!("Material {i}"));
                 material(ui, doc, i, &mut edits);
             }
-            Some(Selection::Node(id)) => node(ui, doc, id, &mut edits),
+            Some(Selection::Node(id)) => node(ui, doc, id, &mut edits, &mut asked),
         });
-    edits
+    edits.into_iter().map(AppCommand::Edit).chain(asked).collect()
 }
 
 /// Three drag values labelled for screen readers and tests (e.g. "Translate x").
@@ -293,7 +296,7 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
     });
 }
 
-fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>) {
+fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, asked: &mut Vec<AppCommand>) {
     let g = &doc.scene.graph;
     let Some(n) = g.get(id) else { return };
     ui.heading(n.kind.name());
@@ -419,25 +422,8 @@ fn node(ui: &mut egui::Ui, doc: &mut Document, id: NodeId, edits: &mut Vec<Edit>
             if ui.button("Load / reload").clicked()
                 || (path != *obj_file && ui.input(|i| i.key_pressed(egui::Key::Enter)))
             {
-                let base = doc.path.as_deref().and_then(|p| p.parent());
-                let slot = match tracelab_core::format::obj::resolve_obj_path(&path, base) {
-                    Ok(p) => {
-                        doc.mesh_cache.forget(&p);
-                        match doc.mesh_cache.load(&p) {
-                            Ok(m) => MeshSlot::Loaded(m),
-                            Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
-                        }
-                    }
-                    Err(e) => MeshSlot::Failed(e),
-                };
                 ui.data_mut(|d| d.remove::<String>(buf_id));
-                edits.push(Edit::SetNodeKind {
-                    node: id,
-                    kind: NodeKind::TriangleMesh {
-                        obj_file: path,
-                        mesh: slot,
-                    },
-                });
+                asked.push(AppCommand::LoadMesh { node: id, obj_file: path });
             }
         }
         NodeKind::Box { min, max } => {

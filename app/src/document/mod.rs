@@ -4,9 +4,12 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use tracelab_core::{MeshCache, NodeId, Problem, Scene, check_scene};
+use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check_scene};
 
-use crate::edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
+pub mod edit;
+
+use crate::io::{Opened, SceneRead, read_scene_file};
+use edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Selection {
@@ -210,6 +213,32 @@ impl Document {
         self.fix_selection();
     }
 
+    /// Selects something (or nothing); a selection that points at nothing in the scene is
+    /// dropped. The one way the app and the panels change the selection.
+    pub fn select(&mut self, selection: Option<Selection>) {
+        self.selection = selection;
+        self.fix_selection();
+    }
+
+    /// Sets a TriangleMesh's `obj_file` and (re)reads that file from disk, as one edit: the
+    /// mesh is read again even when the name is unchanged (the file may have changed), and
+    /// a file that does not load leaves the node with the error. Relative names resolve from
+    /// the document's folder.
+    pub fn load_mesh(&mut self, node: NodeId, obj_file: String) -> Result<(), Refusal> {
+        let base = self.path.as_deref().and_then(Path::parent);
+        let mesh = match tracelab_core::format::obj::resolve_obj_path(&obj_file, base) {
+            Ok(p) => {
+                self.mesh_cache.forget(&p);
+                match self.mesh_cache.load(&p) {
+                    Ok(m) => MeshSlot::Loaded(m),
+                    Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
+                }
+            }
+            Err(e) => MeshSlot::Failed(e),
+        };
+        self.apply(Edit::SetNodeKind { node, kind: NodeKind::TriangleMesh { obj_file, mesh } })
+    }
+
     /// Drops a selection that no longer points at anything.
     fn fix_selection(&mut self) {
         let ok = match self.selection {
@@ -229,7 +258,7 @@ impl Document {
         }
     }
 
-    /// Opens a file now (blocking; the app reads files on a thread, see `crate::loading`).
+    /// Opens a file now (blocking; the app reads files on a thread, see `crate::gui::loading`).
     /// A file that cannot be read at all leaves the current scene open and reports why;
     /// per-node errors (a missing OBJ) open the scene and report them.
     pub fn open(&mut self, path: &Path) -> Result<(), String> {
@@ -347,37 +376,6 @@ impl Document {
     }
 }
 
-/// A scene file as read, before it replaces the document: on any thread, so that a large
-/// mesh cannot freeze the window, and before asking about unsaved changes, so that nothing
-/// is asked when the file cannot be opened.
-pub struct SceneRead {
-    pub path: PathBuf,
-    /// The scene, or the errors that kept it from opening.
-    pub outcome: Result<Opened, Vec<String>>,
-    /// The mesh cache the read used (a copy of the document's plus what it loaded).
-    pub cache: MeshCache,
-}
-
-pub struct Opened {
-    pub scene: Scene,
-    /// Warnings and per-node errors, `file:line:col: message`.
-    pub messages: Vec<String>,
-    /// Comments that saving would drop (see [`Document::save_warnings`]).
-    pub lost_comments: Vec<String>,
-}
-
-/// Reads and parses a scene file with its meshes.
-pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
-    let out = tracelab_core::load_scene(path, &mut cache);
-    let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
-    let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
-    let outcome = match out.scene {
-        Some(scene) => Ok(Opened { scene, messages, lost_comments }),
-        None => Err(messages),
-    };
-    SceneRead { path: path.to_path_buf(), outcome, cache }
-}
-
 fn folder_of(file: &Path) -> PathBuf {
     file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
@@ -389,7 +387,7 @@ fn modified(p: &Path) -> Option<SystemTime> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::edit::Edit;
+    use super::edit::Edit;
     use tracelab_core::NodeKind;
 
     fn temp_dir(name: &str) -> PathBuf {

@@ -1,5 +1,6 @@
-//! The eframe app: wires the document, the panels and the render worker together. Panels
-//! return edits; `apply` here is the only place they reach the document.
+//! The eframe app: wires the document, the panels and the render worker together. Panels,
+//! menus and shortcuts return [`AppCommand`]s; [`TracelabApp::run_commands`] is the one place
+//! that carries them out (edits through `Document::apply`, which records undo).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -8,17 +9,21 @@ use std::time::{Duration, Instant};
 use tracelab_core::Scene;
 use tracelab_core::render::RayStory;
 
-use crate::edit::Edit;
-use crate::loading::{LoadPurpose, Loading};
+use crate::document::edit::Edit;
+use crate::gui::loading::{LoadPurpose, Loading};
 use crate::render_worker::RenderWorker;
-use crate::state::{Document, SceneRead, Selection, read_scene_file};
-use crate::ui::file_dialog::{FileDialog, Purpose};
-use crate::ui::layout::Layout;
-use crate::ui::native_dialog::{Answer, NativeDialog};
-use crate::ui::pixel_inspector::Inspected;
-use crate::ui::tree::TreeRow;
-use crate::ui::viewport::{Compare, Tab, ViewSettings, Viewport};
-use crate::ui::{inspector, pixel_inspector, status, tree};
+use crate::document::{Document, Selection};
+use crate::io::{SceneRead, read_scene_file};
+use crate::gui::command::AppCommand;
+use crate::gui::file_dialog::{FileDialog, Purpose};
+use crate::gui::layout::Layout;
+use crate::gui::menu;
+use crate::gui::settings::Settings;
+use crate::gui::native_dialog::{Answer, NativeDialog};
+use crate::gui::panels::pixel_inspector::Inspected;
+use crate::gui::panels::tree::TreeRow;
+use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
+use crate::gui::panels::{inspector, pixel_inspector, status, tree};
 
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -83,6 +88,8 @@ pub struct TracelabApp {
     tree_seen: Option<Selection>,
     /// Timings in the status bar; snapshot tests turn them off to stay deterministic.
     pub show_timings: bool,
+    /// What the UI asked for this frame, carried out by [`Self::run_commands`].
+    commands: Vec<AppCommand>,
 }
 
 impl TracelabApp {
@@ -114,6 +121,7 @@ impl TracelabApp {
             allow_close: false,
             show_timings: true,
             tree_seen: None,
+            commands: Vec::new(),
         };
         if let Some(cc) = cc {
             let ctx = cc.egui_ctx.clone();
@@ -135,32 +143,97 @@ impl TracelabApp {
     }
 
     pub fn load_persisted(&mut self, s: &dyn eframe::Storage) {
-        if let Some(r) = s.get_string("recent") {
-            self.recent = r
-                .lines()
-                .filter(|l| !l.is_empty())
-                .map(PathBuf::from)
-                .collect();
+        if let Some(settings) = Settings::load(s) {
+            self.apply_settings(settings);
         }
-        if let Some(v) = s.get_string("view") {
-            let mut it = v.split(' ');
-            let mut next = || it.next().unwrap_or("");
-            self.view.tab = match next() {
-                "normals" => Tab::Normals,
-                "depth" => Tab::Depth,
-                "all" => Tab::All,
-                _ => Tab::Color,
-            };
-            self.view.shade_back = next() == "1";
-            if let (Ok(a), Ok(b)) = (next().parse::<f32>(), next().parse::<f32>())
-                && a.is_finite()
-                && b.is_finite()
-            {
-                self.view.depth = (a, b);
+    }
+
+    /// What is kept between runs (see [`Settings`]).
+    pub fn settings(&self) -> Settings {
+        Settings {
+            recent: self.recent.clone(),
+            tab: self.view.tab,
+            shade_back: self.view.shade_back,
+            depth: self.view.depth,
+            layout_epoch: self.layout.epoch,
+        }
+    }
+
+    fn apply_settings(&mut self, s: Settings) {
+        let Settings { recent, tab, shade_back, depth, layout_epoch } = s;
+        self.recent = recent;
+        self.view.tab = tab;
+        self.view.shade_back = shade_back;
+        if depth.0.is_finite() && depth.1.is_finite() {
+            self.view.depth = depth;
+        }
+        self.layout.epoch = layout_epoch;
+    }
+
+    /// Asks for an action; it runs with the others at the end of the frame.
+    pub fn queue(&mut self, command: AppCommand) {
+        self.commands.push(command);
+    }
+
+    /// Carries out what the UI has asked for so far, in order: the one place where panels,
+    /// menus, shortcuts and dialogs change the app. The frame calls it after the menu bar
+    /// (menus, shortcuts, dropped files), after the tree (so the inspector shows a selection
+    /// in the frame it was clicked) and at the end (the inspector, the view, dialogs).
+    pub fn run_commands(&mut self, ctx: &egui::Context) {
+        let commands = std::mem::take(&mut self.commands);
+        let from_panels = commands.iter().all(AppCommand::from_panels);
+        let before = self.doc.generation;
+        for c in commands {
+            self.run_command(c, ctx);
+        }
+        if self.doc.generation != before {
+            if !from_panels {
+                // Undo, New, Open…: no edit buffer from before may show (see `widget_epoch`).
+                self.widget_epoch += 1;
             }
+            self.panels_generation = self.doc.generation;
         }
-        if let Some(e) = s.get_string("layout").and_then(|l| l.trim().parse().ok()) {
-            self.layout.epoch = e;
+    }
+
+    fn run_command(&mut self, command: AppCommand, ctx: &egui::Context) {
+        match command {
+            AppCommand::Select(s) => self.doc.select(s),
+            AppCommand::Edit(e) => self.apply(e),
+            AppCommand::LoadMesh { node, obj_file } => {
+                if let Err(e) = self.doc.load_mesh(node, obj_file) {
+                    self.doc.messages.push(format!("edit refused: {e}"));
+                }
+            }
+            AppCommand::DeleteSelected => {
+                if let Some(Selection::Node(node)) = self.doc.selection {
+                    self.apply(Edit::DeleteNode { node });
+                }
+            }
+            AppCommand::Inspect { frame, x, row } => self.inspect(frame, x, row),
+            AppCommand::New => self.new_document(),
+            AppCommand::OpenDialog => self.show_file_dialog(Purpose::Open),
+            AppCommand::Open(p) => self.open(&p),
+            AppCommand::Save => self.save(),
+            AppCommand::SaveAsDialog => self.show_file_dialog(Purpose::SaveAs),
+            AppCommand::SaveAs(p) => self.save_as(&p),
+            AppCommand::ExportDialog => self.show_file_dialog(Purpose::Export),
+            AppCommand::Export(p) => match self.export(&p) {
+                Ok(files) => self.doc.messages.push(format!(
+                    "exported {}",
+                    files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+                )),
+                Err(e) => self.doc.messages.push(e),
+            },
+            AppCommand::Reload => self.reload(),
+            AppCommand::Quit => self.quit(ctx),
+            AppCommand::Undo => {
+                self.doc.undo();
+            }
+            AppCommand::Redo => {
+                self.doc.redo();
+            }
+            AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
+            AppCommand::ResetLayout => self.layout.reset(),
         }
     }
 
@@ -245,12 +318,7 @@ impl TracelabApp {
         self.viewport.marker = None;
         self.disk_changed = false;
         if reload {
-            self.doc.selection = selection.filter(|s| match s {
-                Selection::Node(id) => self.doc.scene.graph.path_to(*id).is_some(),
-                Selection::Light(i) => *i < self.doc.scene.lights().len(),
-                Selection::Material(i) => *i < self.doc.scene.materials.len(),
-                _ => true,
-            });
+            self.doc.select(selection);
             self.doc
                 .messages
                 .insert(0, format!("{}: reloaded (changed on disk)", path.display()));
@@ -402,7 +470,7 @@ impl TracelabApp {
             if let Some(h) = &story.hit {
                 // Ids are stable across edits that do not delete the node.
                 if self.doc.scene.graph.path_to(h.node).is_some() {
-                    self.doc.selection = Some(Selection::Node(h.node));
+                    self.doc.select(Some(Selection::Node(h.node)));
                 }
             }
             self.viewport.marker = Some((at.x, at.row));
@@ -424,7 +492,7 @@ impl TracelabApp {
     }
 
     /// The images the view drew in the last frame, with the pixels on screen.
-    pub fn shown(&self) -> Vec<crate::ui::viewport::Shown> {
+    pub fn shown(&self) -> Vec<crate::gui::panels::viewport::Shown> {
         self.viewport.shown()
     }
 
@@ -455,132 +523,59 @@ impl TracelabApp {
 
     /// What to do with a path a file dialog gave.
     fn chosen(&mut self, purpose: Purpose, path: &Path) {
-        match purpose {
-            Purpose::Open => self.open(path),
-            Purpose::SaveAs => self.save_as(path),
-            Purpose::Export => match self.export(path) {
-                Ok(files) => self.doc.messages.push(format!(
-                    "exported {}",
-                    files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
-                )),
-                Err(e) => self.doc.messages.push(e),
-            },
-        }
-    }
-
-    fn shortcuts(&mut self, ctx: &egui::Context) {
-        use egui::{Key, KeyboardShortcut, Modifiers};
-        let cmd = Modifiers::COMMAND;
-        let cmd_shift = Modifiers::COMMAND | Modifiers::SHIFT;
-        let pressed = |m: Modifiers, k: Key| {
-            ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(m, k)))
-        };
-        // Longer shortcuts first: Ctrl+Shift+Z must not also count as Ctrl+Z.
-        if pressed(cmd_shift, Key::Z) || pressed(cmd, Key::Y) {
-            self.doc.redo();
-        }
-        if pressed(cmd, Key::Z) {
-            self.doc.undo();
-        }
-        if pressed(cmd_shift, Key::S) {
-            self.show_file_dialog(Purpose::SaveAs);
-        }
-        if pressed(cmd, Key::S) {
-            self.save();
-        }
-        if pressed(cmd, Key::O) {
-            self.show_file_dialog(Purpose::Open);
-        }
-        if pressed(cmd, Key::N) {
-            self.new_document();
-        }
-        if pressed(cmd, Key::Q) {
-            self.quit(ctx);
-        }
-        if !ctx.egui_wants_keyboard_input()
-            && ctx.input(|i| i.key_pressed(Key::Delete))
-            && let Some(Selection::Node(node)) = self.doc.selection
-        {
-            self.apply(Edit::DeleteNode { node });
-        }
+        self.queue(match purpose {
+            Purpose::Open => AppCommand::Open(path.to_path_buf()),
+            Purpose::SaveAs => AppCommand::SaveAs(path.to_path_buf()),
+            Purpose::Export => AppCommand::Export(path.to_path_buf()),
+        });
     }
 
     fn menu(&mut self, ui: &mut egui::Ui) {
+        let mut out = Vec::new();
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("New (Ctrl+N)").clicked() {
-                    self.new_document();
-                }
-                if ui.button("Open… (Ctrl+O)").clicked() {
-                    self.show_file_dialog(Purpose::Open);
-                }
+                menu::button(ui, true, AppCommand::New, &mut out);
+                menu::button(ui, true, AppCommand::OpenDialog, &mut out);
                 ui.menu_button("Open recent", |ui| {
                     if self.recent.is_empty() {
                         ui.label("(none yet)");
                     }
-                    for r in self.recent.clone() {
+                    for r in &self.recent {
                         if ui.button(r.display().to_string()).clicked() {
-                            self.open(&r);
+                            out.push(AppCommand::Open(r.clone()));
                         }
                     }
                 });
-                if ui.button("Save (Ctrl+S)").clicked() {
-                    self.save();
-                }
-                if ui.button("Save As… (Ctrl+Shift+S)").clicked() {
-                    self.show_file_dialog(Purpose::SaveAs);
-                }
-                if ui
-                    .add_enabled(
-                        self.doc.path.is_some(),
-                        egui::Button::new("Reload from disk"),
-                    )
-                    .clicked()
-                {
-                    self.reload();
-                }
-                if ui.button("Export view…").clicked() {
-                    self.show_file_dialog(Purpose::Export);
-                }
+                menu::button(ui, true, AppCommand::Save, &mut out);
+                menu::button(ui, true, AppCommand::SaveAsDialog, &mut out);
+                menu::button(ui, self.doc.path.is_some(), AppCommand::Reload, &mut out);
+                menu::button(ui, true, AppCommand::ExportDialog, &mut out);
                 ui.separator();
-                if ui.button("Quit (Ctrl+Q)").clicked() {
-                    self.quit(ui.ctx());
-                }
+                menu::button(ui, true, AppCommand::Quit, &mut out);
             });
             ui.menu_button("Edit", |ui| {
-                if ui
-                    .add_enabled(self.doc.can_undo(), egui::Button::new("Undo (Ctrl+Z)"))
-                    .clicked()
-                {
-                    self.doc.undo();
-                }
-                if ui
-                    .add_enabled(
-                        self.doc.can_redo(),
-                        egui::Button::new("Redo (Ctrl+Shift+Z)"),
-                    )
-                    .clicked()
-                {
-                    self.doc.redo();
-                }
+                menu::button(ui, self.doc.can_undo(), AppCommand::Undo, &mut out);
+                menu::button(ui, self.doc.can_redo(), AppCommand::Redo, &mut out);
             });
             ui.menu_button("View", |ui| {
-                ui.checkbox(&mut self.pixel_inspector_open, "Pixel inspector");
-                if ui
-                    .button("Reset layout")
+                let mut open = self.pixel_inspector_open;
+                if ui.checkbox(&mut open, "Pixel inspector").changed() {
+                    out.push(AppCommand::ShowPixelInspector(open));
+                }
+                if menu::button(ui, true, AppCommand::ResetLayout, &mut out)
                     .on_hover_text("Panels back to their first sizes")
                     .clicked()
                 {
-                    self.layout.reset();
                     ui.close();
                 }
             });
         });
+        self.commands.extend(out);
     }
 
     fn messages(&mut self, ui: &mut egui::Ui) {
         if let Some(l) = &self.loading
-            && crate::ui::loading::ui(ui, l)
+            && crate::gui::panels::loading::ui(ui, l)
         {
             self.cancel_loading();
         }
@@ -591,7 +586,7 @@ impl TracelabApp {
                     "The file changed on disk, and you have unsaved edits.",
                 );
                 if ui.button("Reload (lose edits)").clicked() {
-                    self.reload();
+                    self.queue(AppCommand::Reload);
                 }
                 if ui.button("Keep mine").clicked() {
                     self.disk_changed = false;
@@ -790,7 +785,8 @@ impl TracelabApp {
 
     fn frame_inner(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
-        self.shortcuts(&ctx);
+        let keys = menu::shortcuts(&ctx);
+        self.commands.extend(keys);
         self.poll_loading();
         self.watch_disk();
         // Files dropped onto the window.
@@ -803,7 +799,7 @@ impl TracelabApp {
                 .collect()
         });
         if let Some(p) = dropped.first() {
-            self.open(p);
+            self.queue(AppCommand::Open(p.clone()));
         }
         if ctx.input(|i| i.viewport().close_requested()) && self.doc.is_dirty() && !self.allow_close
         {
@@ -844,10 +840,11 @@ impl TracelabApp {
             self.menu(ui);
             self.messages(ui);
         });
+        self.run_commands(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| {
             status::ui(ui, &self.doc, &self.worker, self.rows.2, self.show_timings)
         });
-        let mut edits = Vec::new();
+        let mut asked: Vec<AppCommand> = Vec::new();
         let total = ui.available_rect_before_wrap().width();
         let tree = self.layout.tree_panel(total).show(ui, |ui| {
             ui.heading("Scene");
@@ -856,16 +853,19 @@ impl TracelabApp {
                 Some(Selection::Node(id)) if self.doc.selection != self.tree_seen => Some(id),
                 _ => None,
             };
-            edits.extend(tree::ui(ui, &mut self.doc, &rows, reveal));
-            self.tree_seen = self.doc.selection;
+            asked.extend(tree::ui(ui, &self.doc, &rows, reveal));
             self.rows.1 = rows;
         });
+        self.commands.append(&mut asked);
+        self.run_commands(&ctx);
+        // A row clicked in the tree is in view already: only selections made elsewhere scroll.
+        self.tree_seen = self.doc.selection;
         self.layout.shown_tree(tree.response.rect.width());
         let left = ui.available_rect_before_wrap().width();
         let epoch = self.widget_epoch;
         let inspector = self.layout.inspector_panel(left).show(ui, |ui| {
             ui.heading("Inspector");
-            ui.push_id(("document", epoch), |ui| edits.extend(inspector::ui(ui, &mut self.doc)));
+            ui.push_id(("document", epoch), |ui| asked.extend(inspector::ui(ui, &self.doc)));
         });
         self.layout.shown_inspector(inspector.response.rect.width());
         if self.pixel_inspector_open {
@@ -876,7 +876,7 @@ impl TracelabApp {
                 ui.horizontal(|ui| {
                     ui.strong("Pixel inspector");
                     if ui.small_button("Close").clicked() {
-                        self.pixel_inspector_open = false;
+                        asked.push(AppCommand::ShowPixelInspector(false));
                     }
                 });
                 egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| match &self.story {
@@ -896,14 +896,12 @@ impl TracelabApp {
             self.request_render(size);
             pick = self.viewport.images(ui, &mut self.view, &self.worker);
         });
-        for e in edits {
-            self.apply(e);
-        }
-        self.panels_generation = self.doc.generation;
+        self.commands.extend(asked);
         if let Some(p) = pick {
-            self.inspect(p.frame, p.x, p.row);
+            self.queue(AppCommand::Inspect { frame: p.frame, x: p.x, row: p.row });
         }
         self.dialogs(&ctx);
+        self.run_commands(&ctx);
         // Edits and dialogs above changed the document after the view asked for its render:
         // start the new one now, not on the next input event.
         self.request_render(size);
@@ -922,33 +920,12 @@ impl eframe::App for TracelabApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        let recent: Vec<String> = self
-            .recent
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect();
-        storage.set_string("recent", recent.join("\n"));
-        let tab = match self.view.tab {
-            Tab::Color => "color",
-            Tab::Normals => "normals",
-            Tab::Depth => "depth",
-            Tab::All => "all",
-        };
-        storage.set_string(
-            "view",
-            format!(
-                "{tab} {} {} {}",
-                u8::from(self.view.shade_back),
-                self.view.depth.0,
-                self.view.depth.1
-            ),
-        );
-        storage.set_string("layout", self.layout.epoch.to_string());
+        self.settings().save(storage);
     }
 }
 
 /// Opens the window (the `tracelab` command with no subcommand).
-pub fn run(scene: Option<PathBuf>) -> Result<(), String> {
+pub fn run(scene: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 800.0])
@@ -970,5 +947,5 @@ pub fn run(scene: Option<PathBuf>) -> Result<(), String> {
             )))
         }),
     )
-    .map_err(|e| format!("cannot open the window: {e}"))
+    .map_err(|e| anyhow::anyhow!("cannot open the window: {e}"))
 }

@@ -1,11 +1,12 @@
 //! The scene tree (left panel). The scene is first walked into plain rows (testable without
-//! a UI), then drawn; clicks and toolbar buttons become selections and [`Edit`]s.
+//! a UI), then drawn; clicks and toolbar buttons become commands (selections and [`Edit`]s).
 
 use glam::Vec3;
 use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 
-use crate::edit::Edit;
-use crate::state::{Document, Selection};
+use crate::document::edit::Edit;
+use crate::document::{Document, Selection};
+use crate::gui::command::AppCommand;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreeRow {
@@ -99,10 +100,10 @@ pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
 /// (when it was selected elsewhere, e.g. by clicking the render).
 pub fn ui(
     ui: &mut egui::Ui,
-    doc: &mut Document,
+    doc: &Document,
     rows: &[TreeRow],
     reveal: Option<NodeId>,
-) -> Vec<Edit> {
+) -> Vec<AppCommand> {
     let mut edits = Vec::new();
     toolbar(ui, doc, &mut edits);
     ui.separator();
@@ -181,10 +182,11 @@ pub fn ui(
             }
         });
     }
+    let mut asked: Vec<AppCommand> = edits.into_iter().map(AppCommand::Edit).collect();
     if let Some(s) = clicked {
-        doc.selection = Some(s);
+        asked.push(AppCommand::Select(Some(s)));
     }
-    edits
+    asked
 }
 
 fn camera_label(scene: &Scene) -> String {
@@ -196,7 +198,7 @@ fn camera_label(scene: &Scene) -> String {
 
 fn swatch(ui: &mut egui::Ui, c: Vec3) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(10.0, 10.0), egui::Sense::hover());
-    ui.painter().rect_filled(rect, 2.0, crate::ui::color32(c));
+    ui.painter().rect_filled(rect, 2.0, crate::gui::widgets::color32(c));
 }
 
 /// The Group new objects go into: the selected Group, or the Group holding the selection.

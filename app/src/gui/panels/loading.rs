@@ -1,7 +1,7 @@
 //! The strip that shows a scene being read in the background: what it is doing, a progress
 //! bar, and Cancel.
 
-use crate::loading::Loading;
+use crate::gui::loading::Loading;
 
 /// Draws the strip; true when Cancel was clicked.
 pub fn ui(ui: &mut egui::Ui, loading: &Loading) -> bool {

@@ -1,0 +1,52 @@
+//! The benchmarks, with their own options: `tracelab bench` (closest-hit throughput,
+//! [`closest_hit`]) and `tracelab bench-progressive` (the GUI's wait after a change,
+//! [`progressive`]). Their `BENCH`/`PROGRESSIVE` lines are what `../shared/perf` compares.
+
+use std::path::PathBuf;
+
+/// `println!` that checks the write (a full disk is an error, a closed pipe ends the run).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::io::write_stdout(format!("{}\n", format_args!($($arg)*)).as_bytes())?
+    };
+}
+
+mod closest_hit;
+mod progressive;
+
+pub use closest_hit::run;
+pub use progressive::run_progressive;
+
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    pub scene: PathBuf,
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
+    pub size: Vec<u32>,
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
+    pub repeat: usize,
+    /// Trace 4x2 pixel tiles as 8-ray packets (as Embree's rtcIntersect8 loop does).
+    #[arg(long)]
+    pub packets: bool,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ProgressiveArgs {
+    pub scene: PathBuf,
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
+    pub size: Vec<u32>,
+    /// Threads (default: all cores, as the GUI uses).
+    #[arg(long, allow_negative_numbers = true)]
+    pub threads: Option<usize>,
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
+    pub repeat: usize,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+

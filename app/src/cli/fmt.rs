@@ -1,0 +1,24 @@
+//! `tracelab fmt`: a scene file rewritten in canonical form.
+
+use std::path::{Path, PathBuf};
+
+use crate::io::{load_scene, write_stdout};
+
+/// Warnings (comments that cannot be kept, meshes not next to the scene) go to stderr
+/// before anything is written.
+pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()> {
+    let mut s = load_scene(Some(scene))?;
+    if let Some(out) = output {
+        let dir = |p: &Path| p.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        for w in tracelab_core::rebase_mesh_paths(&mut s, &dir(scene), &dir(out)) {
+            eprintln!("{}: warning: {w}", out.display());
+        }
+    }
+    let text = tracelab_core::write_scene(&s);
+    match output {
+        None => write_stdout(text.as_bytes()),
+        Some(out) => crate::io::write_atomic(out, text.as_bytes())
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", out.display())),
+    }
+}
+

@@ -1,0 +1,170 @@
+//! `tracelab render` (and the course's flags, which make the same [`RenderJob`]): a scene to
+//! colour, normal and depth images.
+
+use std::ffi::OsString;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use clap::ValueEnum;
+use tracelab_core::render::{SharedFrame, render_full};
+use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, View};
+
+use super::values::parse_f32;
+use crate::exit::{check_size, usage};
+use crate::io::load_scene;
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (default: the built-in scene).
+    pub scene: Option<PathBuf>,
+    /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [400u32, 400], allow_negative_numbers = true)]
+    pub size: Vec<u32>,
+    /// Colour image.
+    #[arg(long, short)]
+    pub output: Option<PathBuf>,
+    /// Normal image: |n| of the world normal as RGB.
+    #[arg(long)]
+    pub normals: Option<PathBuf>,
+    /// Depth image: t in [MIN, MAX] mapped to white..black (MIN may be negative).
+    #[arg(long, num_args = 3, value_names = ["MIN", "MAX", "FILE"], allow_negative_numbers = true)]
+    pub depth: Option<Vec<OsString>>,
+    /// Shade back-facing surfaces with the flipped normal instead of black.
+    #[arg(long)]
+    pub shade_back: bool,
+    /// How normals go through Transforms.
+    #[arg(long, value_enum, default_value_t = NormalMode::Correct)]
+    pub normal_transform: NormalMode,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalMode {
+    /// (M⁻¹)ᵀ n: perpendicular to the surface under any transform.
+    Correct,
+    /// M n: the lecture's incorrect transformation, for comparison.
+    Incorrect,
+}
+
+impl From<NormalMode> for NormalTransform {
+    fn from(m: NormalMode) -> Self {
+        match m {
+            NormalMode::Correct => NormalTransform::Correct,
+            NormalMode::Incorrect => NormalTransform::Incorrect,
+        }
+    }
+}
+
+/// A request to render, however it was spelled on the command line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderJob {
+    pub scene: Option<PathBuf>,
+    pub width: u32,
+    pub height: u32,
+    pub output: Option<PathBuf>,
+    pub normals: Option<PathBuf>,
+    pub depth: Option<(f32, f32, PathBuf)>,
+    pub shade_back: bool,
+    pub normal_transform: NormalTransform,
+}
+
+pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
+    let depth = match r.depth {
+        None => None,
+        Some(v) => {
+            let [min, max, file] = v.as_slice() else {
+                return Err(usage("--depth needs MIN MAX FILE"));
+            };
+            Some((parse_f32(min, "--depth MIN")?, parse_f32(max, "--depth MAX")?, PathBuf::from(file)))
+        }
+    };
+    let job = RenderJob {
+        scene: r.scene,
+        width: r.size.first().copied().unwrap_or(0),
+        height: r.size.get(1).copied().unwrap_or(0),
+        output: r.output,
+        normals: r.normals,
+        depth,
+        shade_back: r.shade_back,
+        normal_transform: r.normal_transform.into(),
+    };
+    if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
+        return Err(usage("nothing to write: give --output, --normals or --depth"));
+    }
+    Ok(job)
+}
+
+fn check_extension(path: &Path) -> anyhow::Result<()> {
+    match crate::io::image_format(path) {
+        Some(_) => Ok(()),
+        None => Err(usage(format!(
+            "{}: unknown image format (use .png, .tga, .ppm or .bmp)",
+            path.display()
+        ))),
+    }
+}
+
+pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
+    for p in [&job.output, &job.normals].into_iter().flatten().chain(job.depth.as_ref().map(|d| &d.2)) {
+        check_extension(p)?;
+    }
+    // Before loading, and long before allocating the frame.
+    check_size(job.width, job.height)?;
+    let scene = load_scene(job.scene.as_deref())?;
+    let compiled = CompiledScene::new(&scene);
+    let settings = RenderSettings {
+        width: job.width,
+        height: job.height,
+        shade_back: job.shade_back,
+        normal_transform: job.normal_transform,
+    };
+    let frame = render_with_progress(&compiled, &settings);
+    let save = |view: View, depth: (f32, f32), path: &Path| {
+        crate::io::write_image(&frame, view, depth, path).map_err(anyhow::Error::msg)
+    };
+    if let Some(p) = &job.output {
+        save(View::Color, (0.0, 1.0), p)?;
+    }
+    if let Some(p) = &job.normals {
+        save(View::Normals, (0.0, 1.0), p)?;
+    }
+    if let Some((min, max, p)) = &job.depth {
+        save(View::Depth, (*min, *max), p)?;
+    }
+    Ok(())
+}
+
+/// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
+fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
+    let target = Arc::new(SharedFrame::new());
+    let done = Arc::new(AtomicBool::new(false));
+    let watcher = std::io::stderr().is_terminal().then(|| {
+        let (target, done) = (target.clone(), done.clone());
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            let mut shown = false;
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(100));
+                if start.elapsed() > Duration::from_secs(1) {
+                    let p = target.progress();
+                    let bar = (p * 30.0) as usize;
+                    eprint!("\rrendering [{}{}] {:3.0}%", "#".repeat(bar), " ".repeat(30 - bar.min(30)), p * 100.0);
+                    shown = true;
+                }
+            }
+            if shown {
+                eprintln!("\rrendering [{}] 100%", "#".repeat(30));
+            }
+        })
+    });
+    let never = AtomicBool::new(false);
+    let _ = render_full(scene, settings, &target, &never);
+    done.store(true, Ordering::Relaxed);
+    if let Some(w) = watcher {
+        let _ = w.join();
+    }
+    std::mem::replace(&mut *target.lock(), tracelab_core::Frame::new(0, 0))
+}
+

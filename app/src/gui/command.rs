@@ -1,0 +1,56 @@
+//! Every action the UI can ask for, as a value. Panels, menus, shortcuts, dropped files and
+//! file dialogs queue them ([`TracelabApp::queue`]); [`TracelabApp::run_commands`] carries
+//! them out, once a frame, in one place — as rerun's viewer does with its commands.
+
+use std::path::PathBuf;
+
+use tracelab_core::NodeId;
+
+use crate::document::Selection;
+use crate::document::edit::Edit;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum AppCommand {
+    /// Select something in the scene (or nothing).
+    Select(Option<Selection>),
+    /// Change the document (recorded for undo).
+    Edit(Edit),
+    /// Set a TriangleMesh's file and read it from disk (see `Document::load_mesh`).
+    LoadMesh { node: NodeId, obj_file: String },
+    /// Delete the selected node (the Delete key).
+    DeleteSelected,
+    /// Trace one pixel of the image on screen for the pixel inspector, and select what it hit.
+    Inspect { frame: usize, x: u32, row: u32 },
+    New,
+    /// Ask for a file to open.
+    OpenDialog,
+    Open(PathBuf),
+    Save,
+    /// Ask where to save.
+    SaveAsDialog,
+    SaveAs(PathBuf),
+    /// Ask where to export the view.
+    ExportDialog,
+    Export(PathBuf),
+    /// Read the document's file again.
+    Reload,
+    Quit,
+    Undo,
+    Redo,
+    ShowPixelInspector(bool),
+    ResetLayout,
+}
+
+impl AppCommand {
+    /// Commands the panels send about what they show: their own widget state stays valid
+    /// after them. Any other change to the document gives the panels fresh widget ids.
+    pub fn from_panels(&self) -> bool {
+        matches!(self, AppCommand::Select(_) | AppCommand::Edit(_) | AppCommand::LoadMesh { .. })
+    }
+}
+
+impl From<Edit> for AppCommand {
+    fn from(e: Edit) -> Self {
+        AppCommand::Edit(e)
+    }
+}

@@ -1,0 +1,16 @@
+//! The desktop editor (eframe): the app that wires the document, the panels and the render
+//! worker together.
+
+pub mod app;
+pub mod command;
+pub mod drag_speed;
+pub mod file_dialog;
+pub mod layout;
+pub mod loading;
+pub mod menu;
+pub mod native_dialog;
+pub mod panels;
+pub mod settings;
+pub mod widgets;
+
+pub use app::{AppOptions, Pending, TracelabApp, run};

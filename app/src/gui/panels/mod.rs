@@ -1,0 +1,9 @@
+//! The panels. Each reads the document and returns what it asks for (edits, commands); the
+//! app carries those out in one place (`crate::gui::command`).
+
+pub mod inspector;
+pub mod loading;
+pub mod pixel_inspector;
+pub mod status;
+pub mod tree;
+pub mod viewport;

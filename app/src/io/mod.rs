@@ -1,0 +1,78 @@
+//! Files in and out, for the command line and the editor alike: scene files read with
+//! their meshes, outputs written atomically ([`write_atomic`]), images encoded
+//! ([`write_image`]), standard output written with its errors checked ([`write_stdout`]).
+
+mod atomic;
+mod image;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use tracelab_core::{MeshCache, Scene};
+
+pub use atomic::write_atomic;
+pub use image::{encode_image, image_format, write_image};
+
+use crate::exit::Exit;
+
+/// A scene file as read, before it replaces the document: on any thread, so that a large
+/// mesh cannot freeze the window, and before asking about unsaved changes, so that nothing
+/// is asked when the file cannot be opened.
+pub struct SceneRead {
+    pub path: PathBuf,
+    /// The scene, or the errors that kept it from opening.
+    pub outcome: Result<Opened, Vec<String>>,
+    /// The mesh cache the read used (a copy of the document's plus what it loaded).
+    pub cache: MeshCache,
+}
+
+pub struct Opened {
+    pub scene: Scene,
+    /// Warnings and per-node errors, `file:line:col: message`.
+    pub messages: Vec<String>,
+    /// Comments that saving would drop (see `Document::save_warnings`).
+    pub lost_comments: Vec<String>,
+}
+
+/// Reads and parses a scene file with its meshes.
+pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
+    let out = tracelab_core::load_scene(path, &mut cache);
+    let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
+    let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
+    let outcome = match out.scene {
+        Some(scene) => Ok(Opened { scene, messages, lost_comments }),
+        None => Err(messages),
+    };
+    SceneRead { path: path.to_path_buf(), outcome, cache }
+}
+
+/// Reads a scene (`None`: the built-in one) for the command line, printing its warnings to
+/// standard error; errors come back as one message.
+pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
+    let mut cache = MeshCache::new();
+    let outcome = match path {
+        Some(p) => tracelab_core::load_scene(p, &mut cache),
+        None => tracelab_core::parse_scene(crate::DEFAULT_SCENE.as_bytes(), crate::DEFAULT_SCENE_NAME, None, &mut cache),
+    };
+    match outcome.into_result() {
+        Ok((scene, warnings)) => {
+            for w in warnings.warnings() {
+                eprintln!("{w}");
+            }
+            Ok(scene)
+        }
+        Err(diags) => Err(anyhow::Error::msg(diags.to_string())),
+    }
+}
+
+/// Writes to standard output, checking the write and the flush: a reader that closed the
+/// pipe (`| head`) wanted no more, which ends the run quietly ([`Exit::OutputClosed`]);
+/// anything else (a full disk) is an error.
+pub fn write_stdout(bytes: &[u8]) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(Exit::OutputClosed.into()),
+        Err(e) => Err(anyhow::anyhow!("standard output: cannot write: {e}")),
+    }
+}
