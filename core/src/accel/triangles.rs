@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::sah::{self, PrimRef};
 use super::wide::{self, Child, Node8, RayStack, WIDTH};
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::{Aabb, Ray, moller_trumbore};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Tri {
@@ -17,26 +17,11 @@ struct Tri {
 }
 
 impl Tri {
-    /// Two-sided Möller–Trumbore: the ray parameter of a hit, if any.
+    /// The ray parameter of a hit, if any (two-sided, not range-checked). Without the
+    /// infinite-determinant test, as the AVX leaf test, which must agree bit for bit.
     #[inline(always)]
     fn hit(&self, o: Vec3, d: Vec3) -> Option<f32> {
-        let p = d.cross(self.e2);
-        let det = self.e1.dot(p);
-        if det == 0.0 {
-            return None;
-        }
-        let inv_det = 1.0 / det;
-        let s = o - self.v0;
-        let u = s.dot(p) * inv_det;
-        if !(0.0..=1.0).contains(&u) {
-            return None;
-        }
-        let q = s.cross(self.e1);
-        let v = d.dot(q) * inv_det;
-        if v < 0.0 || u + v > 1.0 {
-            return None;
-        }
-        Some(self.e2.dot(q) * inv_det)
+        moller_trumbore::<false>(o, d, self.v0, self.e1, self.e2).map(|(t, _, _)| t)
     }
 }
 
