@@ -204,8 +204,10 @@ impl TriangleBvh {
         self.closest_hit_portable(o, d, t_min, t_max)
     }
 
-    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere).
-    #[inline(always)]
+    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere). Not inlined:
+    /// inlined, this traversal (unused where there is AVX) sat in the renderer's hot
+    /// function, and its shape changed the register allocation of that function's hot part.
+    #[inline(never)]
     pub(super) fn closest_hit_portable(
         &self,
         o: Vec3A,
