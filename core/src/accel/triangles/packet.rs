@@ -24,6 +24,7 @@ impl TriangleBvh {
     /// where two are hit at the very same t). Made for coherent rays (a pixel tile's primary
     /// rays): with AVX, one traversal for the packet, which falls back to single rays when
     /// the active rays' directions differ in sign on some axis (or one is axis-parallel).
+    #[inline]
     pub fn closest_hit8(
         &self,
         o: &[Vec3A; WIDTH],
