@@ -22,12 +22,8 @@ impl BvhNode {
     /// Slab test: the entry distance if the ray meets the box within [t_min, t_max].
     #[inline(always)]
     fn hit(&self, o: Vec3A, inv: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
-        let t0 = (Vec3A::from(self.min) - o) * inv;
-        let t1 = (Vec3A::from(self.max) - o) * inv;
-        // Packed clamps: maxps/minps return the second operand for a NaN lane (0 * inf), so
-        // that axis drops out, without the scalar NaN checks of f32::max.
-        let near = t0.min(t1).max(Vec3A::splat(t_min)).max_element();
-        let far = t0.max(t1).min(Vec3A::splat(t_max)).min_element();
+        let (lo, hi) = (Vec3A::from(self.min), Vec3A::from(self.max));
+        let (near, far) = super::slab::span(lo, hi, o, inv, t_min, t_max);
         (near <= far).then_some(near)
     }
 
@@ -106,8 +102,8 @@ impl Bvh {
             return t_max;
         }
         // One entry per level at most, and the builder keeps leaves above depth MAX_DEPTH.
-        // Exactly 64 entries: 65 made bunny_1k 25% slower (17.4 -> 13.8 Mrays/s, 1 thread),
-        // the odd size turning the zeroing into a memset call on every ray.
+        // Exactly 64 entries: an odd size turns the zeroing into a memset call on every ray
+        // (`docs/perf.md`).
         let mut stack = [0u32; MAX_DEPTH];
         let mut sp = 0usize;
         let mut idx = 0u32;

@@ -3,6 +3,7 @@
 
 mod bvh;
 mod sah;
+mod slab;
 mod triangles;
 mod wide;
 

@@ -7,8 +7,7 @@ use rayon::prelude::*;
 
 use crate::geometry::Aabb;
 
-/// Bins per axis. 32 traced no faster than 16 on the Stanford meshes (within 0.5%) and built
-/// the dragon ~10% slower.
+/// Bins per axis: 32 traced no faster and built slower (`docs/perf.md`).
 const BINS: usize = 16;
 /// Most primitives in a leaf; the 8-wide node packs a leaf's count in 3 bits.
 pub const MAX_LEAF: usize = 8;
@@ -24,10 +23,8 @@ const PARALLEL_BINNING: usize = 1 << 16;
 const TRAVERSAL_COST: f32 = 1.0;
 
 /// How many primitives a leaf tests at once: the SAH charges a leaf by the block, so with
-/// blocks of 8 (the mesh BVH's AVX leaf test) a leaf of 7 costs what a leaf of 1 does.
-/// Measured against charging per primitive (1 thread, 800x800, medians of 7, same minute):
-/// Stanford bunny 10.4 -> 11.5 Mrays/s, dragon 9.2 -> 10.3, bunny_1k 16.8 -> 17.6, cube
-/// unchanged; memory 98 -> 70 bytes/triangle (leaves of 1.85 -> 7.3 triangles).
+/// blocks of 8 (the mesh BVH's AVX leaf test) a leaf of 7 costs what a leaf of 1 does, and
+/// leaves fill up (fewer, fuller leaves trace faster and take less memory: `docs/perf.md`).
 #[derive(Clone, Copy, Debug)]
 pub struct LeafBlock(pub u32);
 
@@ -56,7 +53,7 @@ impl PrimRef {
     }
     /// Twice the centroid: binning only needs it up to a common scale.
     #[inline]
-    fn c2(&self) -> Vec3 {
+    fn doubled_centroid(&self) -> Vec3 {
         self.lo + self.hi
     }
     fn bounds(&self) -> Aabb {
@@ -90,13 +87,15 @@ pub fn build(prims: &mut [PrimRef], block: LeafBlock) -> Option<Node> {
     if prims.is_empty() {
         return None;
     }
-    let (bounds, cb) = extents(prims);
-    Some(build_rec(prims, 0, bounds, cb, 0, block))
+    let (bounds, centroid_box) = extents(prims);
+    Some(build_rec(prims, 0, bounds, centroid_box, 0, block))
 }
 
 /// (union of boxes, box of the doubled centroids).
 fn extents(prims: &[PrimRef]) -> (Aabb, Aabb) {
-    let fold = |acc: (Aabb, Aabb), p: &PrimRef| (acc.0.union(p.bounds()), acc.1.grow(p.c2()));
+    let fold = |acc: (Aabb, Aabb), p: &PrimRef| {
+        (acc.0.union(p.bounds()), acc.1.grow(p.doubled_centroid()))
+    };
     let merge = |a: (Aabb, Aabb), b: (Aabb, Aabb)| (a.0.union(b.0), a.1.union(b.1));
     if prims.len() > PARALLEL_BINNING {
         prims
@@ -142,8 +141,8 @@ struct Binner {
 }
 
 impl Binner {
-    fn new(cb: &Aabb, n: usize) -> Self {
-        let ext = cb.extent();
+    fn new(centroid_box: &Aabb, n: usize) -> Self {
+        let ext = centroid_box.extent();
         let count = (n / 2).clamp(8, BINS);
         // Slightly under count / extent so the largest centroid lands in the last bin.
         let scale = Vec3::select(
@@ -152,19 +151,19 @@ impl Binner {
             Vec3::ZERO,
         );
         Binner {
-            lo: cb.min,
+            lo: centroid_box.min,
             scale,
             count,
         }
     }
     #[inline]
-    fn bin(&self, c2: Vec3, axis: usize) -> usize {
+    fn bin(&self, doubled_centroid: Vec3, axis: usize) -> usize {
         // `as usize` saturates (NaN to 0), and min keeps it in range: no input can index out.
-        (((c2[axis] - self.lo[axis]) * self.scale[axis]) as usize).min(self.count - 1)
+        (((doubled_centroid[axis] - self.lo[axis]) * self.scale[axis]) as usize).min(self.count - 1)
     }
     fn fill(&self, prims: &[PrimRef], bins: &mut Bins) {
         for p in prims {
-            let c = p.c2();
+            let c = p.doubled_centroid();
             let b = p.bounds();
             for a in 0..3 {
                 let k = self.bin(c, a);
@@ -179,7 +178,7 @@ fn build_rec(
     prims: &mut [PrimRef],
     first: usize,
     bounds: Aabb,
-    cb: Aabb,
+    centroid_box: Aabb,
     depth: usize,
     block: LeafBlock,
 ) -> Node {
@@ -194,7 +193,7 @@ fn build_rec(
     }
     // Levels a middle split still needs to reach leaves of MAX_LEAF.
     let levels_needed = (n.div_ceil(MAX_LEAF)).next_power_of_two().trailing_zeros() as usize;
-    let ext = cb.extent();
+    let ext = centroid_box.extent();
     // No positive extent (all centroids equal, or NaN): SAH has nothing to split on.
     let flat = ext.max_element().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater);
     let mid = if depth + levels_needed + 1 >= MAX_DEPTH || flat {
@@ -203,7 +202,7 @@ fn build_rec(
         }
         n / 2
     } else {
-        let binner = Binner::new(&cb, n);
+        let binner = Binner::new(&centroid_box, n);
         let bins = if n > PARALLEL_BINNING {
             prims
                 .par_chunks(PARALLEL_BINNING / 4)
@@ -229,7 +228,7 @@ fn build_rec(
         if n <= MAX_LEAF && cost + TRAVERSAL_COST * area >= block.cost(n as u32) * area {
             return leaf;
         }
-        partition(prims, |p| binner.bin(p.c2(), axis) <= split)
+        partition(prims, |p| binner.bin(p.doubled_centroid(), axis) <= split)
     };
     let mid = if mid == 0 || mid == n { n / 2 } else { mid };
     children(prims, first, bounds, mid, depth, block)

@@ -69,6 +69,24 @@ impl Node8 {
         self.slot_bounds(i).is_empty()
     }
 
+    /// The union of the used slots' boxes.
+    pub fn bounds(&self) -> Aabb {
+        (0..WIDTH)
+            .filter(|&i| !self.slot_is_empty(i))
+            .fold(Aabb::EMPTY, |b, i| b.union(self.slot_bounds(i)))
+    }
+
+    /// Axis `a`'s (entry, exit) rows for a ray whose direction's sign on that axis is
+    /// negative when `toward_neg`: such a ray enters through the max plane.
+    #[inline(always)]
+    pub fn entry_exit(&self, a: usize, toward_neg: bool) -> (&[Vec4; 2], &[Vec4; 2]) {
+        if toward_neg {
+            (&self.hi[a], &self.lo[a])
+        } else {
+            (&self.lo[a], &self.hi[a])
+        }
+    }
+
     fn set(&mut self, i: usize, b: Aabb, c: Child) {
         for a in 0..3 {
             self.lo[a][i / 4][i % 4] = b.min[a];
@@ -150,8 +168,7 @@ impl StackEntry for (Child, f32, u32) {
 /// A fixed, uninitialised stack of (child, entry distance) for one traversal.
 ///
 /// Uninitialised because zeroing its 4 KiB on every ray cost a fifth of the throughput
-/// (measured, best of 20 frames, 800x800, 1 thread: bunny_1k 13.2 vs 16.6 Mrays/s, Stanford
-/// bunny 7.1 vs 8.9).
+/// (`docs/perf.md`).
 pub struct RayStack<E: StackEntry = (Child, f32)> {
     items: [MaybeUninit<E>; STACK],
     len: usize,
@@ -183,6 +200,17 @@ impl<E: StackEntry> RayStack<E> {
         #[allow(unsafe_code)]
         // SAFETY: every index below `len` was written by `push`, and `len` only shrinks here.
         Some(unsafe { self.items[self.len].assume_init() })
+    }
+    /// Pops entries until one is entered no later than `t`: the nearest child not ruled out
+    /// by a hit found since it was pushed.
+    #[inline(always)]
+    pub fn pop_within(&mut self, t: f32) -> Option<E> {
+        while let Some(e) = self.pop() {
+            if e.dist() <= t {
+                return Some(e);
+            }
+        }
+        None
     }
     /// Sorts the top `k` entries so the nearest is on top (popped first).
     #[inline]

@@ -81,26 +81,42 @@ pub fn intersect_triangle(
     t_min: f32,
     t_max: f32,
 ) -> Option<(f32, f32, f32)> {
-    let e1 = b - a;
-    let e2 = c - a;
-    let p = ray.direction.cross(e2);
+    let (t, u, v) = moller_trumbore::<true>(ray.origin, ray.direction, a, b - a, c - a)?;
+    (t > t_min && t < t_max).then_some((t, u, v))
+}
+
+/// Two-sided Möller–Trumbore against the triangle `v0 + u e1 + v e2`: (t, u, v) where the ray
+/// `o + t d` crosses it, t not range-checked. The one scalar copy of the test: the mesh BVH's
+/// AVX leaf repeats these operations lane by lane, so every path gives the same t bit for bit.
+///
+/// `REJECT_INFINITE_DET` also misses when the determinant overflows (its reciprocal would
+/// be 0, and t ±0 or NaN). `intersect_triangle` sets it; the mesh BVH does not, because its
+/// AVX leaf has no such test and the two must agree; with t_min >= 0 the results are the same.
+#[inline(always)]
+pub(crate) fn moller_trumbore<const REJECT_INFINITE_DET: bool>(
+    o: Vec3,
+    d: Vec3,
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+) -> Option<(f32, f32, f32)> {
+    let p = d.cross(e2);
     let det = e1.dot(p);
-    if det == 0.0 || !det.is_finite() {
+    if det == 0.0 || (REJECT_INFINITE_DET && !det.is_finite()) {
         return None;
     }
-    let inv = 1.0 / det;
-    let s = ray.origin - a;
-    let u = s.dot(p) * inv;
+    let inv_det = 1.0 / det;
+    let s = o - v0;
+    let u = s.dot(p) * inv_det;
     if !(0.0..=1.0).contains(&u) {
         return None;
     }
     let q = s.cross(e1);
-    let v = ray.direction.dot(q) * inv;
+    let v = d.dot(q) * inv_det;
     if v < 0.0 || u + v > 1.0 {
         return None;
     }
-    let t = e2.dot(q) * inv;
-    (t > t_min && t < t_max).then_some((t, u, v))
+    Some((e2.dot(q) * inv_det, u, v))
 }
 
 /// The face normal (b − a) × (c − a), normalised: counter-clockwise vertices face the viewer.

@@ -1,0 +1,308 @@
+//! One ray through the tree: the closest hit (the SSE slab test anywhere, the AVX kernels
+//! where the CPU has them) and every hit (for CSG).
+
+use glam::{Vec3A, Vec4};
+
+#[cfg(target_arch = "x86_64")]
+use super::avx::{self, LeafRay};
+use super::{SLAB_WIDEN, TriangleBvh, TriangleHit, finite_ray, has_avx};
+use crate::accel::wide::{self, Child, Node8, RayStack, StackEntry, WIDTH};
+use crate::geometry::Ray;
+
+/// A ray set up for the slab tests: origin, direction, reciprocal direction, and per axis
+/// whether it runs toward -axis (so it enters a box through the max plane).
+///
+/// 16-byte `Vec3A`s, not `Vec3`s: the tests broadcast single components, and 12-byte fields
+/// were loaded as 16 bytes spanning two earlier stores, a failed store forward on every ray
+/// (`docs/perf.md`).
+pub(super) struct SlabRay {
+    pub(super) o: Vec3A,
+    pub(super) d: Vec3A,
+    pub(super) inv: Vec3A,
+    pub(super) toward_neg: [bool; 3],
+}
+
+impl SlabRay {
+    #[inline(always)]
+    pub(super) fn new(o: Vec3A, d: Vec3A) -> Self {
+        // One packed division rather than three scalar ones on every ray's critical path.
+        let inv = d.recip();
+        SlabRay {
+            o,
+            d,
+            inv,
+            toward_neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+        }
+    }
+
+    /// Whether the ray meets the box [lo, hi] within [t_min, t_max], widened as `slab8`
+    /// widens so it never culls a box the traversal would enter.
+    #[inline(always)]
+    fn enters(&self, lo: Vec3A, hi: Vec3A, t_min: f32, t_max: f32) -> bool {
+        let (near, far) = crate::accel::slab::span(lo, hi, self.o, self.inv, t_min, t_max);
+        near <= far * SLAB_WIDEN
+    }
+
+    /// Entry distances of all eight slots into `t_enter`; bit i of the result is set when
+    /// slot i is entered within [t_min, t_max]. Two SSE halves; `avx::slab8` is one register.
+    #[inline(always)]
+    fn slab8(&self, n: &Node8, t_min: f32, t_max: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
+        let (nx, fx) = n.entry_exit(0, self.toward_neg[0]);
+        let (ny, fy) = n.entry_exit(1, self.toward_neg[1]);
+        let (nz, fz) = n.entry_exit(2, self.toward_neg[2]);
+        let (o, inv) = (self.o, self.inv);
+        let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
+        let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
+        let (t0, t1) = (Vec4::splat(t_min), Vec4::splat(t_max));
+        let mut mask = 0u32;
+        let mut near = [Vec4::ZERO; 2];
+        for h in 0..2 {
+            // maxps/minps return the second operand when the first is NaN (0 * inf on an
+            // axis-parallel ray), so that axis drops out instead of poisoning the result.
+            let a = ((nx[h] - ox) * ix)
+                .max((ny[h] - oy) * iy)
+                .max(((nz[h] - oz) * iz).max(t0));
+            let b = ((fx[h] - ox) * ix)
+                .min((fy[h] - oy) * iy)
+                .min(((fz[h] - oz) * iz).min(t1));
+            mask |= a.cmple(b * SLAB_WIDEN).bitmask() << (4 * h);
+            near[h] = a;
+        }
+        let (lo, hi) = t_enter.split_at_mut(4);
+        lo.copy_from_slice(&near[0].to_array());
+        hi.copy_from_slice(&near[1].to_array());
+        mask
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl LeafRay for SlabRay {
+    #[inline(always)]
+    fn origin(&self) -> Vec3A {
+        self.o
+    }
+    #[inline(always)]
+    fn direction(&self) -> Vec3A {
+        self.d
+    }
+}
+
+/// Where the traversal goes from a node whose slots in `mask` the ray enters, at distances
+/// `t_enter`: returns the nearest slot's entry to visit now and pushes the others so the
+/// nearest of them pops first. One slot: itself; two: the far one pushed, no sort (the lower
+/// slot wins a tie); more: all pushed, the top insertion-sorted, the nearest popped.
+/// `entry(slot)` is what the stack holds for a slot. None when `mask` is empty.
+#[inline(always)]
+pub(super) fn nearest_first<E: StackEntry>(
+    mask: u32,
+    t_enter: &[f32; WIDTH],
+    stack: &mut RayStack<E>,
+    entry: impl Fn(usize) -> E,
+) -> Option<E> {
+    if mask == 0 {
+        return None;
+    }
+    let i = mask.trailing_zeros() as usize;
+    let rest = mask & (mask - 1);
+    if rest == 0 {
+        return Some(entry(i));
+    }
+    if rest & (rest - 1) == 0 {
+        let j = rest.trailing_zeros() as usize;
+        let (near, far) = if t_enter[i] <= t_enter[j] {
+            (i, j)
+        } else {
+            (j, i)
+        };
+        stack.push(entry(far));
+        return Some(entry(near));
+    }
+    let mut m = mask;
+    let mut k = 0;
+    while m != 0 {
+        let j = m.trailing_zeros() as usize;
+        m &= m - 1;
+        stack.push(entry(j));
+        k += 1;
+    }
+    stack.sort_top(k);
+    stack.pop()
+}
+
+/// The closest-hit traversal, generic over the 8-box test and the leaf test, and inlined
+/// into the function that picks them so each copy is compiled for the instruction set that
+/// function enables (`closest_hit_portable`, `closest_hit_avx`).
+#[inline(always)]
+fn closest_hit_with(
+    bvh: &TriangleBvh,
+    r: &SlabRay,
+    t_min: f32,
+    t_max: f32,
+    slab8: impl Fn(&SlabRay, &Node8, f32, f32, &mut [f32; WIDTH]) -> u32,
+    leaf: impl Fn(&SlabRay, usize, usize, f32, f32) -> Option<(f32, usize)>,
+) -> Option<TriangleHit> {
+    if bvh.nodes.is_empty() || !r.enters(bvh.root_lo, bvh.root_hi, t_min, t_max) {
+        return None;
+    }
+    let mut t_best = t_max;
+    let mut best = usize::MAX;
+    let mut stack = RayStack::new();
+    let mut t_enter = [0.0f32; WIDTH];
+    let mut cur: Child = 0;
+    loop {
+        if wide::is_leaf(cur) {
+            let (first, count) = wide::leaf_range(cur);
+            if let Some((t, k)) = leaf(r, first, count, t_min, t_best) {
+                t_best = t;
+                best = k;
+            }
+        } else {
+            let n = &bvh.nodes[cur as usize];
+            let mask = slab8(r, n, t_min, t_best, &mut t_enter);
+            let entry = |s: usize| (n.child[s], t_enter[s]);
+            if let Some((c, _)) = nearest_first(mask, &t_enter, &mut stack, entry) {
+                cur = c;
+                continue;
+            }
+        }
+        match stack.pop_within(t_best) {
+            Some((c, _)) => cur = c,
+            None => {
+                return (best != usize::MAX).then(|| TriangleHit {
+                    t: t_best,
+                    triangle: bvh.ids[best],
+                });
+            }
+        }
+    }
+}
+
+impl TriangleBvh {
+    /// Closest hit in (t_min, t_max). Two-sided Möller–Trumbore.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        self.closest_hit(ray.origin.into(), ray.direction.into(), t_min, t_max)
+    }
+
+    /// `intersect` for a ray given as 16-byte vectors, the form the traversal keeps. Callers
+    /// that build the ray just before (the renderer's object-space transform) should use it:
+    /// a `Ray`'s 12-byte fields, loaded as vectors right after they were stored, defeat the
+    /// store forward (`docs/perf.md`).
+    #[inline]
+    pub fn closest_hit(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        // A NaN or infinite ray (an overflowing object-space transform) makes every slab
+        // test NaN, which would enter the empty slots, whose child is the root: endless.
+        if !finite_ray(o, d) {
+            return None;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above (std caches the answer).
+            return unsafe { self.closest_hit_avx(o, d, t_min, t_max) };
+        }
+        self.closest_hit_portable(o, d, t_min, t_max)
+    }
+
+    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere). Not inlined:
+    /// inlined, this traversal (unused where there is AVX) sat in the renderer's hot
+    /// function, and its shape changed the register allocation of that function's hot part.
+    #[inline(never)]
+    pub(super) fn closest_hit_portable(
+        &self,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        closest_hit_with(
+            self,
+            &SlabRay::new(o, d),
+            t_min,
+            t_max,
+            SlabRay::slab8,
+            |r, first, count, t_min, t_best| self.leaf_scalar(r, first, count, t_min, t_best),
+        )
+    }
+
+    /// The closest hit with the AVX kernels: the eight slots in one register, a leaf's
+    /// triangles in one test.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn closest_hit_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
+        closest_hit_with(
+            self,
+            &SlabRay::new(o, d),
+            t_min,
+            t_max,
+            |r, n, t_min, t_max, t_enter| {
+                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+            },
+            |r, first, count, t_min, t_best| avx::leaf8(self, r, first, count, t_min, t_best),
+        )
+    }
+
+    /// The nearest hit in (t_min, t_best) among triangles first..first+count, one at a time:
+    /// (t, index in leaf order). The first of equal t wins.
+    #[inline(always)]
+    fn leaf_scalar(
+        &self,
+        r: &SlabRay,
+        first: usize,
+        count: usize,
+        t_min: f32,
+        t_best: f32,
+    ) -> Option<(f32, usize)> {
+        let mut best = None;
+        let mut t_best = t_best;
+        for k in first..first + count {
+            if let Some(t) = self.tri(k).hit(r.o.into(), r.d.into())
+                && t > t_min
+                && t < t_best
+            {
+                t_best = t;
+                best = Some((t, k));
+            }
+        }
+        best
+    }
+
+    /// Every hit with t in (t_min, t_max), in no particular order, appended to `out`. CSG
+    /// needs all crossings of a closed mesh along a ray, not just the nearest.
+    pub fn intersect_all(&self, ray: &Ray, t_min: f32, t_max: f32, out: &mut Vec<TriangleHit>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        if !finite_ray(ray.origin.into(), ray.direction.into()) {
+            return; // as in `closest_hit`
+        }
+        let r = SlabRay::new(ray.origin.into(), ray.direction.into());
+        let mut stack = RayStack::new();
+        let mut t_enter = [0.0f32; WIDTH];
+        stack.push((0, t_min));
+        while let Some((c, _)) = stack.pop() {
+            if wide::is_leaf(c) {
+                let (first, count) = wide::leaf_range(c);
+                for k in first..first + count {
+                    if let Some(t) = self.tri(k).hit(r.o.into(), r.d.into())
+                        && t > t_min
+                        && t < t_max
+                    {
+                        out.push(TriangleHit {
+                            t,
+                            triangle: self.ids[k],
+                        });
+                    }
+                }
+                continue;
+            }
+            let n = &self.nodes[c as usize];
+            let mut mask = r.slab8(n, t_min, t_max, &mut t_enter);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.push((n.child[i], t_enter[i]));
+            }
+        }
+    }
+}
