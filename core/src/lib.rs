@@ -20,13 +20,3 @@ pub use scene::{
     NodeKind, Scene, TransformOp, Invalid, Place, Problem, check_scene,
 };
 
-/// Helpers for this crate's unit tests.
-#[cfg(test)]
-mod test_support {
-    /// Libtest swallows `eprintln!` from passing tests, and a skip must be seen: write to the
-    /// process's stderr directly.
-    pub fn skip_note(msg: &str) {
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), "{msg}");
-    }
-}
