@@ -66,7 +66,8 @@ def strip(text):
             out.append(c)
             i += 1
     text = "".join(out)
-    m = re.search(r"#\[cfg\(test\)\]\s*mod\s+\w+\s*\{", text)
+    # `#[cfg(test)]` or `#[cfg(all(test, unix))]` and the like.
+    m = re.search(r"#\[cfg\((?:all\()?test\b[^\]]*\]\s*mod\s+\w+\s*\{", text)
     return text[: m.start()] if m else text
 
 

@@ -120,6 +120,23 @@ fn fmt_writes_canonical_text_that_reads_back() {
     assert!(leftovers.is_empty());
 }
 
+/// `fmt` rewrites text: it must not need the meshes the scene names (it used to exit 1).
+#[test]
+fn fmt_rewrites_a_scene_whose_obj_file_is_missing() {
+    let d = temp_dir("fmt-no-obj");
+    let src = "OrthographicCamera{center 0 0 10 direction 0 0 -1 up 0 1 0 size 5}\nMaterials{numMaterials 1 Material{diffuseColor 1 0 0}}\nGroup{numObjects 1 MaterialIndex 0 TriangleMesh{obj_file not_here.obj}}";
+    std::fs::write(d.join("s.txt"), src).expect("write");
+    let o = tracelab(&["fmt", "s.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("TriangleMesh {\n        obj_file not_here.obj\n"), "{text}");
+    assert!(!stderr(&o).contains("cannot load"), "{}", stderr(&o));
+    // Rendering it still says what is missing.
+    let o = tracelab(&["render", "s.txt", "--size", "8", "8", "--output", "o.png"], &d);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("cannot load OBJ file \"not_here.obj\""), "{}", stderr(&o));
+}
+
 #[test]
 fn fmt_keeps_comments() {
     let d = temp_dir("fmt-comments");

@@ -8,7 +8,10 @@ pub mod geometry;
 pub mod render;
 pub mod scene;
 
-pub use format::{Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, parse_scene, rebase_mesh_paths, try_write_scene, write_scene};
+pub use format::{
+    Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, load_scene_unresolved, parse_scene,
+    parse_scene_unresolved, rebase_mesh_paths, resolve_meshes, try_write_scene, write_scene,
+};
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
 pub use render::{
     CompiledScene, Frame, NormalTransform, RenderSettings, Sample, SharedFrame, View, compile, render_frame,

@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 use tracelab_core::geometry::Ray;
-use tracelab_core::render::csg::{Bound, CsgTree, FLIP_BIT, box_face_normal, box_span};
+use tracelab_core::geometry::{box_face_normal, box_span};
+use tracelab_core::render::csg::{Bound, CsgTree, FLIP_BIT};
 use tracelab_core::render::{Frame, Shape};
 use tracelab_core::{
     CompiledScene, MeshCache, NormalTransform, RenderSettings, Scene, compile, parse_scene, render_frame,

@@ -3,7 +3,7 @@
 
 mod common;
 use common::{Rng, mutate};
-use tracelab_core::{MeshCache, ParseOutcome, Severity, parse_scene};
+use tracelab_core::{MeshCache, MeshSlot, NodeKind, ParseOutcome, Severity, parse_scene, parse_scene_unresolved, resolve_meshes};
 
 const HEAD: &str = "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 -1\n    up 0 1 0\n    size 5\n}\n\
 Materials {\n    numMaterials 1\n    Material { diffuseColor 1 0 0 }\n}\n";
@@ -152,6 +152,43 @@ fn missing_obj_is_an_error_on_that_node_and_the_scene_survives() {
     assert!(e[0].message.starts_with("cannot load OBJ file \"no_such_mesh.obj\": file not found"), "{}", e[0]);
     // Structure is intact: the editor can open it and show the error on the node.
     assert!(out.scene.is_some());
+}
+
+/// Parsing opens no file: the mesh is listed with its location and loaded by a step of its
+/// own, which reports the same error the one-call `parse_scene` does.
+#[test]
+fn parsing_alone_leaves_meshes_unresolved_and_resolving_reports_the_missing_file() {
+    let text = body("Group {\n numObjects 1\n MaterialIndex 0\n TriangleMesh { obj_file no_such_mesh.obj }\n}\n");
+    let mut out = parse_scene_unresolved(text.as_bytes(), "t.txt");
+    assert!(!out.diagnostics.has_errors(), "{}", out.diagnostics);
+    let scene = out.scene.as_ref().expect("parses");
+    let mesh = scene.graph.preorder().into_iter().find_map(|id| match &scene.graph.node(id).kind {
+        NodeKind::TriangleMesh { mesh, .. } => Some(mesh.clone()),
+        _ => None,
+    });
+    assert_eq!(mesh, Some(MeshSlot::Unresolved));
+    assert_eq!(out.meshes.len(), 1);
+    assert_eq!((out.meshes[0].obj_file.as_str(), out.meshes[0].at.line, out.meshes[0].at.col), ("no_such_mesh.obj", HEAD_LINES + 4, 26));
+    resolve_meshes(&mut out, None, &mut MeshCache::new());
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 1, "{}", out.diagnostics);
+    assert_eq!((e[0].line, e[0].col), (HEAD_LINES + 4, 26));
+    assert!(e[0].message.starts_with("cannot load OBJ file \"no_such_mesh.obj\": file not found"), "{}", e[0]);
+    assert!(out.meshes.is_empty(), "resolved once");
+    let scene = out.scene.expect("still usable");
+    assert!(scene.graph.preorder().into_iter().any(|id| matches!(&scene.graph.node(id).kind, NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_), .. })));
+}
+
+/// A million missing meshes are reported as a screenful, as the parser's own errors are.
+#[test]
+fn many_missing_meshes_are_capped_like_parse_errors() {
+    let n = 500;
+    let objects: String = (0..n).map(|i| format!(" TriangleMesh {{ obj_file missing_{i}.obj }}\n")).collect();
+    let out = parse(&body(&format!("Group {{\n numObjects {n}\n MaterialIndex 0\n{objects}}}\n")));
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 21, "20 shown and a summary");
+    assert_eq!(e[20].message, format!("… and {} more errors", n - 20));
+    assert!(e[20].message.len() < 40);
 }
 
 #[test]

@@ -2,12 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::io::{load_scene, write_stdout};
+use crate::io::{load_scene_text, write_stdout};
 
-/// Warnings (comments that cannot be kept, meshes not next to the scene) go to stderr
-/// before anything is written.
+/// Warnings (comments that cannot be kept) go to stderr before anything is written. OBJ
+/// files are not opened: the text is all `fmt` rewrites.
 pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()> {
-    let mut s = load_scene(Some(scene))?;
+    let mut s = load_scene_text(scene)?;
     if let Some(out) = output {
         let dir = |p: &Path| p.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
         for w in tracelab_core::rebase_mesh_paths(&mut s, &dir(scene), &dir(out)) {

@@ -234,7 +234,7 @@ impl Document {
                     Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
                 }
             }
-            Err(e) => MeshSlot::Failed(e),
+            Err(e) => MeshSlot::Failed(e.to_string()),
         };
         self.apply(Edit::SetNodeKind { node, kind: NodeKind::TriangleMesh { obj_file, mesh } })
     }
@@ -341,17 +341,18 @@ impl Document {
     }
 
     /// The checked writer's text for `scene` (the document rebased for `path`), read back as
-    /// the file at `path` would be, meshes included, and required to be the same document.
+    /// the file at `path` would be (meshes are not loaded: what they are is not written), and
+    /// required to be the same document.
     fn checked_text(&mut self, scene: &Scene, path: &Path) -> Result<String, String> {
         let name = path.display().to_string();
         let text = tracelab_core::try_write_scene(scene).map_err(|problems| {
             let what: Vec<String> = problems.iter().map(|p| format!("  {}", p.message)).collect();
             format!("{name}: not saved; first fix:\n{}", what.join("\n"))
         })?;
-        let back = tracelab_core::parse_scene(text.as_bytes(), &name, Some(&folder_of(path)), &mut self.mesh_cache);
+        let back = tracelab_core::parse_scene_unresolved(text.as_bytes(), &name);
         let why = match back.scene {
             // Node errors (an OBJ that does not load) open too, as they did here.
-            Some(read) => scene.reads_back_as(&read).err(),
+            Some(read) => scene.reads_back_as(&read).err().map(|e| e.to_string()),
             None => Some(format!("it would not open again:\n{}", back.diagnostics)),
         };
         match why {

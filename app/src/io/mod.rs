@@ -54,6 +54,16 @@ pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
         Some(p) => tracelab_core::load_scene(p, &mut cache),
         None => tracelab_core::parse_scene(crate::DEFAULT_SCENE.as_bytes(), crate::DEFAULT_SCENE_NAME, None, &mut cache),
     };
+    warn_or_fail(outcome)
+}
+
+/// Reads a scene without loading its meshes (for `fmt`, which rewrites the text and needs
+/// no OBJ file), printing its warnings to standard error.
+pub fn load_scene_text(path: &Path) -> anyhow::Result<Scene> {
+    warn_or_fail(tracelab_core::load_scene_unresolved(path))
+}
+
+fn warn_or_fail(outcome: tracelab_core::ParseOutcome) -> anyhow::Result<Scene> {
     match outcome.into_result() {
         Ok((scene, warnings)) => {
             for w in warnings.warnings() {

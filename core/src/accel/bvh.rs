@@ -163,7 +163,11 @@ impl Bvh {
     /// Checks the structural invariants: every primitive in exactly one leaf, no node deeper
     /// than the traversal stack, children inside their parents' bounds, leaves holding the
     /// boxes of their primitives. For tests.
-    pub fn check_invariants(&self, bounds: &[Aabb]) -> Result<(), String> {
+    pub fn check_invariants(&self, bounds: &[Aabb]) -> Result<(), super::InvariantViolation> {
+        self.invariants(bounds).map_err(super::InvariantViolation)
+    }
+
+    fn invariants(&self, bounds: &[Aabb]) -> Result<(), String> {
         if bounds.is_empty() {
             return if self.nodes.is_empty() {
                 Ok(())

@@ -2,8 +2,11 @@
 //! so a mesh used twice is read and its BVH built once. Plain files go through a fast parallel
 //! reader; anything it does not understand goes to `tobj`, the reference.
 
+mod error;
 mod fast;
 mod file_kind;
+
+pub use error::{MESH_LOAD_CANCELLED, ObjError};
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -28,7 +31,7 @@ pub const MAX_OBJ_BYTES: usize = 512 << 20;
 /// holding the mesh). It cannot mask a saved path: the scene's own folder is tried first,
 /// Save As and `fmt -o` rewrite relative paths against that folder alone
 /// ([`crate::format::rebase_mesh_paths`]), and the parser warns whenever the fallback is used.
-pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, String> {
+pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, ObjError> {
     let mut tried = Vec::new();
     let mut candidates = Vec::new();
     if let Some(dir) = base_dir {
@@ -41,10 +44,10 @@ pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, 
         match file_kind(&p) {
             FileKind::Missing => continue,
             FileKind::Regular => return Ok(p),
-            other => return Err(format!("{} {}", p.display(), other.describe())),
+            other => return Err(ObjError::NotAFile { path: p, what: other.describe() }),
         }
     }
-    Err(format!("file not found (looked in {})", tried.join(" and ")))
+    Err(ObjError::NotFound { tried })
 }
 
 /// Meshes already loaded, by canonical path; reused while the file is unchanged on disk.
@@ -58,11 +61,8 @@ pub struct MeshCache {
 
 /// Told before each step of reading an OBJ file from disk (meshes served from the cache are
 /// not reported), for a progress display. Returning `false` stops that load: it fails with
-/// [`MESH_LOAD_CANCELLED`], and so does every later one, at once.
+/// [`ObjError::Cancelled`], and so does every later one, at once.
 pub type MeshObserver = Arc<dyn Fn(MeshEvent<'_>) -> bool + Send + Sync>;
-
-/// The message of a mesh load stopped by its observer.
-pub const MESH_LOAD_CANCELLED: &str = "loading cancelled";
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MeshEvent<'a> {
@@ -92,9 +92,9 @@ impl MeshCache {
         self.observer = observer;
     }
 
-    pub fn load(&mut self, path: &Path) -> Result<Arc<Mesh>, String> {
+    pub fn load(&mut self, path: &Path) -> Result<Arc<Mesh>, ObjError> {
         let canon = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let meta = std::fs::metadata(&canon).map_err(|e| e.to_string())?;
+        let meta = std::fs::metadata(&canon)?;
         let stamp = (meta.modified().ok(), meta.len());
         if let Some((t, len, m)) = self.meshes.get(&canon)
             && (*t, *len) == stamp
@@ -105,16 +105,16 @@ impl MeshCache {
         let go_on = |e: MeshEvent<'_>| observer.as_ref().is_none_or(|o| o(e));
         let loaded = (|| {
             if !go_on(MeshEvent::Reading { path: &canon, bytes: meta.len() }) {
-                return Err(MESH_LOAD_CANCELLED.to_string());
+                return Err(ObjError::Cancelled);
             }
             let bytes = read_obj_bytes(&canon)?;
             if !go_on(MeshEvent::Parsing { path: &canon }) {
-                return Err(MESH_LOAD_CANCELLED.to_string());
+                return Err(ObjError::Cancelled);
             }
             let (positions, triangles) = parse_obj_triangles(&bytes, &file_name(&canon))?;
             drop(bytes);
             if !go_on(MeshEvent::Building { path: &canon, triangles: triangles.len() }) {
-                return Err(MESH_LOAD_CANCELLED.to_string());
+                return Err(ObjError::Cancelled);
             }
             Ok(Mesh::new(positions, triangles))
         })();
@@ -137,38 +137,38 @@ fn file_name(path: &Path) -> String {
 
 /// Reads one OBJ file into a single mesh (all its objects and groups together). Only regular
 /// files are read (a FIFO is never opened), at most `MAX_OBJ_BYTES` of them.
-pub fn load_obj(path: &Path) -> Result<Mesh, String> {
+pub fn load_obj(path: &Path) -> Result<Mesh, ObjError> {
     let bytes = read_obj_bytes(path)?;
     parse_obj(&bytes, &file_name(path))
 }
 
 /// The bytes of an OBJ file: a regular file only, at most `MAX_OBJ_BYTES`.
-fn read_obj_bytes(path: &Path) -> Result<Vec<u8>, String> {
+fn read_obj_bytes(path: &Path) -> Result<Vec<u8>, ObjError> {
     use std::io::Read as _;
     let file = open_regular(path)?;
     let mut bytes = Vec::new();
-    file.take(MAX_OBJ_BYTES as u64 + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    file.take(MAX_OBJ_BYTES as u64 + 1).read_to_end(&mut bytes)?;
     if bytes.len() > MAX_OBJ_BYTES {
-        return Err(format!("the file is larger than {} MiB, the most tracelab reads as an OBJ mesh", MAX_OBJ_BYTES >> 20));
+        return Err(ObjError::TooLarge { limit_mib: MAX_OBJ_BYTES >> 20 });
     }
     Ok(bytes)
 }
 
 /// Parses OBJ text (`name` is used in messages): the fast reader when it understands the
 /// file, else tobj.
-pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, String> {
+pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, ObjError> {
     let (positions, triangles) = parse_obj_triangles(bytes, name)?;
     Ok(Mesh::new(positions, triangles))
 }
 
 /// Positions and triangles of OBJ text, checked, before the BVH is built.
-fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
     let (positions, triangles) = match fast::parse(bytes) {
         Some(r) => r,
         None => load_with_tobj(bytes, name)?,
     };
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(format!("vertex {} is not finite", i + 1));
+        return Err(ObjError::Syntax(format!("vertex {} is not finite", i + 1)));
     }
     Ok((positions, triangles))
 }
@@ -181,12 +181,12 @@ pub fn parse_obj_fast(bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
 /// The reference reader: every OBJ feature tobj knows, all objects and groups merged.
 /// `mtllib` files are never opened: tracelab shades with the scene's materials, and a
 /// material library could be a FIFO or a device.
-pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
     let opts = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
     let no_materials = |_: &Path| -> tobj::MTLLoadResult { Err(tobj::LoadError::OpenFileFailed) };
     let (models, _materials) = match tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials) {
         Ok(r) => r,
-        Err(e) => return Err(locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string())),
+        Err(e) => return Err(ObjError::Syntax(locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string()))),
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -197,8 +197,9 @@ pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 
         for t in m.mesh.indices.chunks_exact(3) {
             let tri = [t[0] + base, t[1] + base, t[2] + base];
             if tri.iter().any(|&i| i >= nv) {
-                return Err(locate_obj_error(bytes, name)
-                    .unwrap_or_else(|| "a face refers to a vertex that does not exist".into()));
+                return Err(ObjError::Syntax(
+                    locate_obj_error(bytes, name).unwrap_or_else(|| "a face refers to a vertex that does not exist".into()),
+                ));
             }
             triangles.push(tri);
         }
@@ -307,7 +308,7 @@ mod tests {
             s.lock().expect("lock").push(step);
             !(stop.load(std::sync::atomic::Ordering::Relaxed) && matches!(e, MeshEvent::Building { .. }))
         })));
-        assert_eq!(cache.load(&p).expect_err("stopped"), MESH_LOAD_CANCELLED);
+        assert_eq!(cache.load(&p).expect_err("stopped"), ObjError::Cancelled);
         let reading = format!("reading {}", text.len());
         assert_eq!(*seen.lock().expect("lock"), [reading.as_str(), "parsing", "building 2", "done"]);
         // A stopped load caches nothing: the next one reads the file again.
@@ -326,7 +327,7 @@ mod tests {
     fn bad_face_reports_obj_line() {
         let p = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n");
         let e = load_obj(&p).expect_err("must fail");
-        assert!(e.contains("bad.obj:4"), "{e}");
+        assert!(e.to_string().contains("bad.obj:4"), "{e}");
     }
 
     /// The same triangles, as vertex positions, from the fast reader and from tobj.

@@ -11,16 +11,18 @@ use glam::{Mat4, Vec3};
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
 use super::lexer::{TokKind, Token};
 use super::token_stream::TokenStream;
-use super::obj::{MeshCache, resolve_obj_path};
 
 use crate::scene::{
     Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node,
-    NodeId, NodeKind, Scene, SceneComments, TransformOp, check_closed, validate,
+    NodeId, NodeKind, Scene, SceneComments, TransformOp, validate,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
 /// completely; it may still come with errors that concern single nodes (an OBJ file that
 /// could not be loaded), which `diagnostics.has_errors()` reports.
+///
+/// Parsing never touches the file system: TriangleMesh nodes come back
+/// [`MeshSlot::Unresolved`], listed in `meshes`, until [`super::resolve_meshes`] loads them.
 #[derive(Debug)]
 pub struct ParseOutcome {
     pub scene: Option<Scene>,
@@ -29,6 +31,8 @@ pub struct ParseOutcome {
     /// value): writing the scene drops them. Each is also among `diagnostics` as a warning;
     /// kept apart so a save can repeat them (see [`ParseOutcome::lost_comments`]).
     pub lost_comments: Vec<Diagnostic>,
+    /// Each TriangleMesh node still to be loaded, with where its file name stands.
+    pub meshes: Vec<MeshRef>,
 }
 
 impl ParseOutcome {
@@ -50,16 +54,18 @@ impl ParseOutcome {
 /// files); the cap keeps a device, a FIFO or a mistaken huge file from filling memory.
 pub const MAX_SCENE_BYTES: usize = 64 << 20;
 
-/// Reads and parses a scene file; OBJ paths resolve against the file's folder first.
-pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
+/// Reads and parses a scene file without loading its meshes (what `tracelab fmt` needs: it
+/// works when an OBJ file is missing).
+pub fn load_scene_unresolved(path: &Path) -> ParseOutcome {
     let name = path.display().to_string();
     let whole_file_error = |message: String| ParseOutcome {
         scene: None,
         diagnostics: Diagnostics(vec![Diagnostic { severity: Severity::Error, file: name.clone(), line: 0, col: 0, message }]),
         lost_comments: Vec::new(),
+        meshes: Vec::new(),
     };
     match read_capped(path, MAX_SCENE_BYTES) {
-        Ok(Some(bytes)) => parse_scene(&bytes, &name, path.parent(), cache),
+        Ok(Some(bytes)) => parse_scene_unresolved(&bytes, &name),
         Ok(None) => whole_file_error(format!("the file is larger than {} MiB, the most tracelab reads as a scene", MAX_SCENE_BYTES >> 20)),
         Err(e) => whole_file_error(format!("cannot read scene file: {e}")),
     }
@@ -76,9 +82,8 @@ pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec
     Ok((bytes.len() <= cap).then_some(bytes))
 }
 
-/// Parses scene text. `name` is used in messages; `base_dir` is where OBJ files are looked
-/// for first (then the current folder).
-pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mut MeshCache) -> ParseOutcome {
+/// Parses scene text only: no file is opened, meshes stay [`MeshSlot::Unresolved`].
+pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
     let text = match std::str::from_utf8(bytes) {
         Ok(t) if !t.contains('\0') => t,
         other => {
@@ -96,7 +101,7 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
                 valid_up_to,
                 format!("this is not a text scene file: found {what}"),
             );
-            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]), lost_comments: Vec::new() };
+            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]), lost_comments: Vec::new(), meshes: Vec::new() };
         }
     };
     let mut p = Parser {
@@ -110,8 +115,6 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         diags: Vec::new(),
         unshown: Unshown::default(),
         fatal: false,
-        base_dir,
-        cache,
         camera: None,
         camera_seen: false,
         group_seen: false,
@@ -122,7 +125,9 @@ pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mu
         material_refs: Vec::new(),
         leaf_offsets: Vec::new(),
         node_offsets: Vec::new(),
-        closed_meshes: HashMap::new(),
+        mesh_name_offsets: Vec::new(),
+        mesh_operands: Vec::new(),
+        last_obj_name: 0,
     };
     p.parse_file();
     p.finish()
@@ -143,8 +148,6 @@ struct Parser<'a> {
     unshown: Unshown,
     /// Set by any error that leaves the scene incomplete.
     fatal: bool,
-    base_dir: Option<&'a Path>,
-    cache: &'a mut MeshCache,
     camera: Option<Camera>,
     /// A camera or object Group block was present (even if broken): do not also report it missing.
     camera_seen: bool,
@@ -159,14 +162,36 @@ struct Parser<'a> {
     leaf_offsets: Vec<(NodeId, usize)>,
     /// Offset of each object's keyword, indexed by node id (for errors about operands).
     node_offsets: Vec<usize>,
-    /// Closedness already checked, per mesh (by address), so a mesh used many times is
-    /// checked once.
-    closed_meshes: HashMap<usize, Result<(), String>>,
+    /// (node, offset of its file name) of each TriangleMesh, for the resolve step.
+    mesh_name_offsets: Vec<(NodeId, usize)>,
+    /// (mesh node, operation, offset) of each TriangleMesh that is a CSG operand: the
+    /// resolve step checks that it is closed.
+    mesh_operands: Vec<(NodeId, CsgOp, usize)>,
+    /// Offset of the last TriangleMesh's file name, read by `start_object`.
+    last_obj_name: usize,
+}
+
+/// Where something stands in a scene file (1-based line and column).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Located {
+    pub file: String,
+    pub line: u32,
+    pub col: u32,
+}
+
+/// A TriangleMesh node as the parser left it: the file to load, where its name stands, and
+/// the CSG operations it is an operand of (each with the operand's location).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshRef {
+    pub node: NodeId,
+    pub obj_file: String,
+    pub at: Located,
+    pub operand_of: Vec<(CsgOp, Located)>,
 }
 
 /// Errors (and, separately, warnings) past this many are counted, not shown: a file of a
 /// million stray braces must not print a million lines.
-const MAX_SHOWN: usize = 20;
+pub(super) const MAX_SHOWN: usize = 20;
 
 /// Diagnostics beyond the first `MAX_SHOWN` of their severity: how many, and where the first
 /// of them is.
@@ -330,10 +355,6 @@ impl<'a> Parser<'a> {
 
     fn error(&mut self, offset: usize, msg: impl Into<String>) {
         self.fatal = true;
-        self.report(Severity::Error, offset, msg);
-    }
-
-    fn node_error(&mut self, offset: usize, msg: impl Into<String>) {
         self.report(Severity::Error, offset, msg);
     }
 
@@ -1133,8 +1154,12 @@ impl<'a> Parser<'a> {
             _ => {
                 let (kind, mut comments) = self.parse_primitive(w, off, open)?;
                 comments.before = before;
+                let is_mesh = matches!(kind, NodeKind::TriangleMesh { .. });
                 let id = attach(self, graph, kind, comments);
                 self.leaf_offsets.push((id, off));
+                if is_mesh {
+                    self.mesh_name_offsets.push((id, self.last_obj_name));
+                }
                 None
             }
         }
@@ -1178,8 +1203,8 @@ impl<'a> Parser<'a> {
                 f[i].used = true;
                 self.reject_unused(&f, w, "obj_file");
                 let (name, name_off) = f[i].word.clone()?;
-                let mesh = self.load_mesh(&name, name_off);
-                NodeKind::TriangleMesh { obj_file: name, mesh }
+                self.last_obj_name = name_off;
+                NodeKind::TriangleMesh { obj_file: name, mesh: MeshSlot::Unresolved }
             }
             _ => return None,
         };
@@ -1188,27 +1213,6 @@ impl<'a> Parser<'a> {
             return None;
         }
         Some((kind, comments))
-    }
-
-    fn load_mesh(&mut self, name: &str, off: usize) -> MeshSlot {
-        let result = resolve_obj_path(name, self.base_dir).and_then(|path| self.cache.load(&path));
-        match result {
-            Ok(mesh) => {
-                if let Some(dir) = self.base_dir.filter(|d| !d.join(name).is_file()) {
-                    let dir = if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() };
-                    self.warn(off, format!("OBJ file \"{name}\" is not in the scene's folder ({dir}); using the one in the current folder"));
-                }
-                if mesh.triangle_count() == 0 {
-                    self.warn(off, format!("OBJ file \"{name}\" has no triangles"));
-                }
-                MeshSlot::Loaded(mesh)
-            }
-            Err(msg) => {
-                // The scene is still usable; this node renders nothing until fixed.
-                self.node_error(off, format!("cannot load OBJ file \"{name}\": {msg}"));
-                MeshSlot::Failed(msg)
-            }
-        }
     }
 
     fn close_frame(&mut self, frame: Frame, graph: &mut Graph) {
@@ -1270,18 +1274,8 @@ impl<'a> Parser<'a> {
                 at,
                 format!("a Group cannot be an operand of {name}: operands are solids (Sphere, Box, Plane, closed TriangleMesh, a Transform of one, or Union, Intersection, Subtraction); combine several with Union"),
             ),
-            NodeKind::TriangleMesh { obj_file, mesh } => {
-                // A mesh that failed to load was reported already.
-                let Some(mesh) = mesh.mesh() else { return };
-                let key = std::sync::Arc::as_ptr(mesh) as usize;
-                let result = self.closed_meshes.entry(key).or_insert_with(|| check_closed(mesh)).clone();
-                if let Err(why) = result {
-                    self.node_error(
-                        at,
-                        format!("TriangleMesh \"{obj_file}\" is not a closed solid, so it cannot be an operand of {name}: {why}"),
-                    );
-                }
-            }
+            // Whether it is closed is known once it is loaded (the resolve step).
+            NodeKind::TriangleMesh { .. } => self.mesh_operands.push((cur, op, at)),
             NodeKind::Transform(_) => {}
         }
     }
@@ -1341,6 +1335,35 @@ impl<'a> Parser<'a> {
                 comments: std::mem::take(&mut self.scene_comments),
             })
         };
-        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments }
+        let meshes = self.mesh_refs(scene.as_ref());
+        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments, meshes }
+    }
+
+    /// The TriangleMesh nodes with their file names and locations (also for a scene too
+    /// broken to keep, so that a missing OBJ file is reported with the other errors).
+    fn mesh_refs(&self, scene: Option<&Scene>) -> Vec<MeshRef> {
+        let graph = scene.map(|s| &s.graph).or(self.graph.as_ref());
+        let place = |off: usize| {
+            let d = self.src.diagnostic(Severity::Error, off, "");
+            Located { file: d.file, line: d.line, col: d.col }
+        };
+        let mut refs: Vec<MeshRef> = self
+            .mesh_name_offsets
+            .iter()
+            .filter_map(|&(node, off)| {
+                let obj_file = match graph.and_then(|g| g.get(node)).map(|n| &n.kind) {
+                    Some(NodeKind::TriangleMesh { obj_file, .. }) => obj_file.clone(),
+                    _ => return None,
+                };
+                Some(MeshRef { node, obj_file, at: place(off), operand_of: Vec::new() })
+            })
+            .collect();
+        let index: HashMap<NodeId, usize> = refs.iter().enumerate().map(|(i, r)| (r.node, i)).collect();
+        for &(node, op, off) in &self.mesh_operands {
+            if let Some(&i) = index.get(&node) {
+                refs[i].operand_of.push((op, place(off)));
+            }
+        }
+        refs
     }
 }

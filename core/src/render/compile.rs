@@ -5,13 +5,16 @@
 
 use std::sync::Arc;
 
-use glam::{DMat4, Mat3, Mat4, Vec3, Vec3A};
+use glam::{DMat4, Vec3, Vec3A};
 
 use super::camera::CameraRays;
-use super::csg::{CsgTree, box_face_normal, box_span};
+use super::csg::CsgTree;
 use super::NormalTransform;
 use crate::accel::Bvh;
-use crate::geometry::{Aabb, Ray, intersect_plane, intersect_sphere, intersect_triangle, triangle_normal};
+use crate::geometry::{
+    Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere, intersect_triangle,
+    triangle_normal,
+};
 use crate::scene::validate::compose_f64;
 use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
 
@@ -29,36 +32,10 @@ pub enum Shape {
     Csg(Arc<CsgTree>),
 }
 
-/// A transform with everything rays and normals need, computed once.
-#[derive(Clone, Copy, Debug)]
-pub struct Xf {
-    pub world_from_object: Mat4,
-    pub object_from_world: Mat4,
-    /// (M⁻¹)ᵀ for normals: M itself skews them under non-uniform scale and shear.
-    pub normal_from_object: Mat3,
-}
-
-impl Xf {
-    /// Inverts once, here, so no ray ever pays for it.
-    pub fn new(world_from_object: Mat4) -> Xf {
-        Self::from_pair(world_from_object, world_from_object.inverse())
-    }
-
-    /// From a matrix composed in f64: inverted there, so tiny and huge scales keep their
-    /// digits in the f32 pair.
-    pub fn from_f64(world_from_object: DMat4) -> Xf {
-        Self::from_pair(world_from_object.as_mat4(), world_from_object.inverse().as_mat4())
-    }
-
-    fn from_pair(world_from_object: Mat4, inv: Mat4) -> Xf {
-        Xf { world_from_object, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
-    }
-}
-
 #[derive(Clone, Debug)]
 pub struct Object {
     pub shape: Shape,
-    pub xf: Option<Xf>,
+    pub xf: Option<Transform>,
     /// Index into `CompiledScene::materials` (the last entry is the default material).
     pub material: u32,
     pub node: NodeId,
@@ -130,7 +107,7 @@ impl CompiledScene {
                     Shape::Triangle { vertices: [*a, *b, *c], normal: triangle_normal(*a, *b, *c) }
                 }
                 NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. } => Shape::Mesh(mesh.clone()),
-                NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_), .. } => continue,
+                NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_) | MeshSlot::Unresolved, .. } => continue,
                 NodeKind::Box { min, max } => Shape::Box { min: *min, max: *max },
                 NodeKind::Csg(_) => {
                     // One object for the whole subtree: its leaves keep their own transforms
@@ -141,7 +118,7 @@ impl CompiledScene {
                     continue;
                 }
             };
-            let xf = (m != DMat4::IDENTITY).then(|| Xf::from_f64(m));
+            let xf = (m != DMat4::IDENTITY).then(|| Transform::from_f64(m));
             let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
             objects.push(Object { shape, xf, material, node: id });
         }

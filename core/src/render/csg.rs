@@ -12,9 +12,8 @@ use std::sync::Arc;
 use glam::{DMat4, Vec3};
 
 use super::NormalTransform;
-use super::compile::Xf;
 use crate::accel::TriangleHit;
-use crate::geometry::{Aabb, Ray, sphere_roots};
+use crate::geometry::{Aabb, Ray, Transform, box_face_normal, box_span, sphere_roots};
 use crate::scene::validate::compose_f64;
 use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
 
@@ -74,7 +73,7 @@ pub enum Solid {
 pub struct CsgLeaf {
     pub solid: Solid,
     /// The leaf's whole world transform (Transforms above the CSG node included).
-    pub xf: Option<Xf>,
+    pub xf: Option<Transform>,
     /// Index into `CompiledScene::materials`: a surface keeps its operand's material.
     pub material: u32,
     pub node: NodeId,
@@ -166,7 +165,7 @@ impl CsgTree {
             program.push(Step::Leaf(leaves.len() as u32));
             leaves.push(CsgLeaf {
                 solid,
-                xf: (m != DMat4::IDENTITY).then(|| Xf::from_f64(m)),
+                xf: (m != DMat4::IDENTITY).then(|| Transform::from_f64(m)),
                 material: resolve(material),
                 node: id.unwrap_or(root),
             });
@@ -293,45 +292,6 @@ fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
         Some(xf) => local.transformed(&xf.world_from_object),
         None => local,
     }
-}
-
-/// A box face: axis · 2 + 1 for the max side. Its outward normal is `box_face_normal`.
-pub fn box_face_normal(face: u32) -> Vec3 {
-    let axis = (face / 2).min(2) as usize;
-    let mut n = Vec3::ZERO;
-    n[axis] = if face % 2 == 1 { 1.0 } else { -1.0 };
-    n
-}
-
-/// Where a ray is inside an axis-aligned box, by slabs, over the whole line:
-/// (t_enter, entry face, t_exit, exit face), or None if it misses (or only grazes an edge).
-pub fn box_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<(f32, u32, f32, u32)> {
-    let (o, d) = (ray.origin, ray.direction);
-    let (mut near, mut near_face) = (f32::NEG_INFINITY, 0u32);
-    let (mut far, mut far_face) = (f32::INFINITY, 0u32);
-    for axis in 0..3 {
-        if d[axis] == 0.0 {
-            // Parallel to this slab: inside it everywhere or nowhere.
-            if o[axis] < min[axis] || o[axis] > max[axis] {
-                return None;
-            }
-            continue;
-        }
-        let inv = 1.0 / d[axis];
-        let (t_lo, t_hi) = ((min[axis] - o[axis]) * inv, (max[axis] - o[axis]) * inv);
-        let a = axis as u32 * 2;
-        // Moving toward +axis the ray enters through the min face and leaves through the max.
-        let (t_in, f_in, t_out, f_out) = if d[axis] > 0.0 { (t_lo, a, t_hi, a + 1) } else { (t_hi, a + 1, t_lo, a) };
-        if t_in > near {
-            near = t_in;
-            near_face = f_in;
-        }
-        if t_out < far {
-            far = t_out;
-            far_face = f_out;
-        }
-    }
-    (near < far).then_some((near, near_face, far, far_face))
 }
 
 /// Appends a leaf's sorted boundaries along the whole (object-space) ray.
@@ -498,13 +458,4 @@ mod tests {
         assert!(out.is_empty());
     }
 
-    #[test]
-    fn box_span_names_entry_and_exit_faces() {
-        let r = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
-        let (t0, f0, t1, f1) = box_span(&r, Vec3::splat(-1.0), Vec3::splat(1.0)).expect("hit");
-        assert_eq!((t0, t1), (4.0, 6.0));
-        assert_eq!((box_face_normal(f0), box_face_normal(f1)), (Vec3::NEG_X, Vec3::X));
-        let miss = Ray::new(Vec3::new(-5.0, 2.0, 0.0), Vec3::X);
-        assert!(box_span(&miss, Vec3::splat(-1.0), Vec3::splat(1.0)).is_none());
-    }
 }

@@ -11,7 +11,7 @@ mod progressive;
 mod shade;
 
 pub use camera::CameraRays;
-pub use compile::{CompiledScene, Hit, Object, Shape, Xf};
+pub use compile::{CompiledScene, Hit, Object, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};

@@ -52,9 +52,12 @@ impl Mesh {
     }
 }
 
-/// A TriangleMesh node's geometry: loaded, or the reason it could not be.
+/// A TriangleMesh node's geometry: not looked for yet, loaded, or the reason it could not be.
 #[derive(Clone, Debug)]
 pub enum MeshSlot {
+    /// As the parser leaves it: the OBJ file has not been opened
+    /// ([`crate::format::resolve_meshes`] loads it). Renders nothing.
+    Unresolved,
     Loaded(Arc<Mesh>),
     /// Not loaded (missing or broken file); the node renders nothing and shows this message.
     Failed(String),
@@ -65,6 +68,7 @@ impl PartialEq for MeshSlot {
         match (self, other) {
             (MeshSlot::Loaded(a), MeshSlot::Loaded(b)) => Arc::ptr_eq(a, b) || a == b,
             (MeshSlot::Failed(a), MeshSlot::Failed(b)) => a == b,
+            (MeshSlot::Unresolved, MeshSlot::Unresolved) => true,
             _ => false,
         }
     }
@@ -74,17 +78,27 @@ impl MeshSlot {
     pub fn mesh(&self) -> Option<&Arc<Mesh>> {
         match self {
             MeshSlot::Loaded(m) => Some(m),
-            MeshSlot::Failed(_) => None,
+            MeshSlot::Failed(_) | MeshSlot::Unresolved => None,
         }
     }
+}
+
+/// Why a mesh does not bound a solid.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NotClosed {
+    #[error("it has no triangles")]
+    Empty,
+    /// An edge (1-based vertex numbers, as in the OBJ file) on `count` triangles, not 2.
+    #[error("the edge between vertices {a} and {b} belongs to {count} triangle(s), not 2")]
+    OpenEdge { a: u32, b: u32, count: usize },
 }
 
 /// Checks that a mesh bounds a solid: every edge is shared by exactly two triangles, so a
 /// ray's crossings alternate between entering and leaving. CSG needs that; an open mesh
 /// would give a wrong picture rather than an error.
-pub fn check_closed(mesh: &Mesh) -> Result<(), String> {
+pub fn check_closed(mesh: &Mesh) -> Result<(), NotClosed> {
     if mesh.triangles.is_empty() {
-        return Err("it has no triangles".to_string());
+        return Err(NotClosed::Empty);
     }
     let mut edges: Vec<(u32, u32)> = Vec::with_capacity(mesh.triangles.len() * 3);
     for t in &mesh.triangles {
@@ -102,12 +116,7 @@ pub fn check_closed(mesh: &Mesh) -> Result<(), String> {
         }
         if j - i != 2 {
             let (a, b) = edges[i];
-            return Err(format!(
-                "the edge between vertices {} and {} belongs to {} triangle(s), not 2",
-                a + 1,
-                b + 1,
-                j - i
-            ));
+            return Err(NotClosed::OpenEdge { a: a + 1, b: b + 1, count: j - i });
         }
         i = j;
     }
@@ -127,6 +136,6 @@ mod tests {
         let all = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
         assert_eq!(check_closed(&tetra(all.clone())), Ok(()));
         let open = check_closed(&tetra(all[..3].to_vec())).expect_err("open");
-        assert!(open.contains("1 triangle(s)"), "{open}");
+        assert!(matches!(open, NotClosed::OpenEdge { count: 1, .. }), "{open}");
     }
 }

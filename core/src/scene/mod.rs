@@ -10,9 +10,9 @@ pub mod validate;
 
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
-pub use mesh::{Mesh, MeshSlot, check_closed};
+pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
 pub use transform::{TransformOp, compose};
-pub use validate::{Invalid, Place, Problem, check_scene, unit};
+pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene, unit};
 
 use glam::Vec3;
 
@@ -147,13 +147,22 @@ impl Scene {
     }
 }
 
+/// The first part of a scene that would not read back the same after writing it: `part`
+/// is "the camera", "the lights", "the background", "the materials", "the objects" or "the
+/// comments".
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{part} would read back differently")]
+pub struct ReadsBackDifferently {
+    pub part: &'static str,
+}
+
 impl Scene {
     /// Whether `back` (this scene written and read again) is the same document: the graph
     /// compacted, every material a list continues spelt out, meshes compared by file name
     /// (whether one loads depends on the disk, not on the text), comments as the same lines
     /// (the writer may move one whose field is gone to the end of its block). `Err` names
     /// the first part that differs.
-    pub fn reads_back_as(&self, back: &Scene) -> Result<(), String> {
+    pub fn reads_back_as(&self, back: &Scene) -> Result<(), ReadsBackDifferently> {
         let (a, a_lines) = self.normalised();
         let (b, b_lines) = back.normalised();
         let parts = [
@@ -165,7 +174,7 @@ impl Scene {
             ("the comments", a_lines == b_lines),
         ];
         match parts.iter().find(|(_, same)| !same) {
-            Some((what, _)) => Err(format!("{what} would read back differently")),
+            Some((part, _)) => Err(ReadsBackDifferently { part }),
             None => Ok(()),
         }
     }
@@ -190,7 +199,7 @@ impl Scene {
             let n = s.graph.node_mut(id);
             take(&mut n.comments);
             if let NodeKind::TriangleMesh { mesh, .. } = &mut n.kind {
-                *mesh = MeshSlot::Failed(String::new());
+                *mesh = MeshSlot::Unresolved;
             }
         }
         lines.sort();

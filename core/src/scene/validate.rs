@@ -30,6 +30,9 @@ impl Invalid {
     }
 }
 
+impl std::error::Error for Invalid {}
+impl std::error::Error for Problem {}
+
 impl std::fmt::Display for Invalid {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.message)
@@ -314,8 +317,16 @@ pub fn compose_f64(ops: &[TransformOp]) -> DMat4 {
         .fold(DMat4::IDENTITY, |m, op| m * op_matrix_f64(op))
 }
 
+/// A world-from-object matrix, composed through a chain of Transforms, that rays cannot be
+/// moved through; `why` finishes "the combined transforms down to here …".
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("singular transform: the combined transforms down to here {why}")]
+pub struct SingularTransform {
+    pub why: &'static str,
+}
+
 /// Whether a world-from-object matrix (composed through the whole chain) can be used.
-pub fn check_world_from_object(m: &DMat4) -> Result<(), String> {
+pub fn check_world_from_object(m: &DMat4) -> Result<(), SingularTransform> {
     let why = singular(DMat3::from_mat4(*m)).or_else(|| {
         (!m.to_cols_array()
             .iter()
@@ -323,9 +334,7 @@ pub fn check_world_from_object(m: &DMat4) -> Result<(), String> {
         .then_some("overflows")
     });
     match why {
-        Some(why) => Err(format!(
-            "singular transform: the combined transforms down to here {why}"
-        )),
+        Some(why) => Err(SingularTransform { why }),
         None => Ok(()),
     }
 }
@@ -513,7 +522,8 @@ pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
         let Some(node) = graph.get(id) else { continue };
         if let NodeKind::Transform(ops) = &node.kind {
             world *= compose_f64(ops);
-            if let Err(message) = check_world_from_object(&world) {
+            if let Err(e) = check_world_from_object(&world) {
+                let message = e.to_string();
                 out.push(Problem {
                     place: Place::Node(id),
                     field: "ops".into(),

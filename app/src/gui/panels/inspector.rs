@@ -418,6 +418,9 @@ fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, as
                 MeshSlot::Failed(e) => {
                     ui.colored_label(ui.visuals().error_fg_color, e.as_str());
                 }
+                MeshSlot::Unresolved => {
+                    ui.colored_label(ui.visuals().warn_fg_color, "not loaded yet");
+                }
             }
             if ui.button("Load / reload").clicked()
                 || (path != *obj_file && ui.input(|i| i.key_pressed(egui::Key::Enter)))

@@ -43,7 +43,7 @@ pub fn node_label(kind: &NodeKind, children: usize) -> String {
             MeshSlot::Loaded(m) => {
                 format!("TriangleMesh: {obj_file} ({} tris)", m.triangle_count())
             }
-            MeshSlot::Failed(_) => format!("TriangleMesh: {obj_file} (not loaded)"),
+            MeshSlot::Failed(_) | MeshSlot::Unresolved => format!("TriangleMesh: {obj_file} (not loaded)"),
         },
         NodeKind::Box { min, max } => format!("Box: ({}) to ({})", v(*min), v(*max)),
         NodeKind::Csg(op) => {

@@ -38,7 +38,11 @@ impl TriangleBvh {
         &self,
         positions: &[Vec3],
         triangles: &[[u32; 3]],
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::accel::InvariantViolation> {
+        self.invariants(positions, triangles).map_err(crate::accel::InvariantViolation)
+    }
+
+    fn invariants(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), String> {
         let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
         let tri_box = |t: &[u32; 3]| Aabb::from_points(&[vert(t[0]), vert(t[1]), vert(t[2])]);
         if triangles.is_empty() {

@@ -5,6 +5,8 @@ use std::fs::File;
 use std::io::ErrorKind;
 use std::path::Path;
 
+use super::error::ObjError;
+
 #[derive(Debug, PartialEq, Eq)]
 pub enum FileKind {
     Regular,
@@ -85,16 +87,17 @@ fn kind_of(t: &std::fs::FileType) -> FileKind {
 
 /// Opens `path` only if it is a regular file, and checks the opened handle again, so a file
 /// swapped for a FIFO between the check and the open cannot block the reader.
-pub fn open_regular(path: &Path) -> Result<File, String> {
+pub fn open_regular(path: &Path) -> Result<File, ObjError> {
+    let not_a_file = |k: FileKind| ObjError::NotAFile { path: path.to_path_buf(), what: k.describe() };
     match file_kind(path) {
         FileKind::Regular => {}
-        other => return Err(format!("{} {}", path.display(), other.describe())),
+        other => return Err(not_a_file(other)),
     }
-    let file = open_nonblocking(path).map_err(|e| e.to_string())?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
+    let file = open_nonblocking(path)?;
+    let meta = file.metadata()?;
     match kind_of(&meta.file_type()) {
         FileKind::Regular => Ok(file),
-        other => Err(format!("{} {}", path.display(), other.describe())),
+        other => Err(not_a_file(other)),
     }
 }
 
@@ -134,7 +137,7 @@ mod tests {
         assert_eq!(file_kind(Path::new("/dev/null")), FileKind::Device);
         // Refused without blocking (a blocking open of a FIFO would hang this test).
         let e = open_regular(&dir.join("pipe")).expect_err("a FIFO");
-        assert!(e.ends_with("is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only"), "{e}");
+        assert!(e.to_string().ends_with("is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only"), "{e}");
         assert!(open_regular(&dir.join("f.obj")).is_ok());
         let _ = std::fs::remove_dir_all(&dir);
     }
