@@ -9,6 +9,7 @@ pub mod document;
 pub mod exit;
 pub mod gui;
 pub mod io;
+pub mod logging;
 pub mod render_worker;
 
 /// The scene tracelab opens when started with no file.

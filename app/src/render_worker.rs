@@ -160,7 +160,7 @@ impl Drop for RenderWorker {
 }
 
 fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
-    let log = std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0");
+    let log = log::log_enabled!(target: crate::logging::TIMES, log::Level::Info);
     while let Ok(mut next) = rx.recv() {
         // Only the newest request matters.
         while let Ok(newer) = rx.try_recv() {
@@ -250,8 +250,9 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
         };
         if ok && log {
             shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_ref().inspect(|p| {
-                eprintln!(
-                    "tracelab: generation {} {}x{}{}: edit to first image {:.1} ms, to full refinement {:.1} ms",
+                log::info!(
+                    target: crate::logging::TIMES,
+                    "generation {} {}x{}{}: edit to first image {:.1} ms, to full refinement {:.1} ms",
                     p.job.generation,
                     p.job.settings.width,
                     p.job.settings.height,

@@ -60,6 +60,7 @@ pub enum Command {
 }
 
 pub fn main() -> ExitCode {
+    crate::logging::init();
     // args_os: a file name need not be UTF-8.
     let args: Vec<OsString> = std::env::args_os().collect();
     match run(&args) {

@@ -17,6 +17,7 @@ use crate::io::{SceneRead, read_scene_file};
 use crate::gui::command::AppCommand;
 use crate::gui::file_dialog::{FileDialog, Purpose};
 use crate::gui::layout::Layout;
+use crate::gui::file_watch::{self, FileWatch};
 use crate::gui::menu;
 use crate::gui::settings::Settings;
 use crate::gui::native_dialog::{Answer, NativeDialog};
@@ -79,7 +80,7 @@ pub struct TracelabApp {
     panels_generation: u64,
     pub recent: Vec<PathBuf>,
     rows: (u64, Vec<TreeRow>, (usize, usize, usize)),
-    last_disk_check: Instant,
+    file_watch: FileWatch,
     /// The file changed on disk while there were unsaved edits: ask before reloading.
     pub disk_changed: bool,
     title: String,
@@ -115,7 +116,7 @@ impl TracelabApp {
             panels_generation: 0,
             recent: Vec::new(),
             rows: (0, Vec::new(), (0, 0, 0)),
-            last_disk_check: Instant::now(),
+            file_watch: FileWatch::default(),
             disk_changed: false,
             title: String::new(),
             allow_close: false,
@@ -754,12 +755,10 @@ impl TracelabApp {
 
     /// Watches the file: reload quietly when nothing is unsaved, else ask.
     fn watch_disk(&mut self) {
-        if self.last_disk_check.elapsed() < Duration::from_millis(700) {
-            return;
-        }
-        self.last_disk_check = Instant::now();
-        // A read under way will set the stamp; asking again would restart it.
-        if self.loading.is_some() {
+        self.file_watch.follow(self.doc.path.as_deref(), self.repaint.clone());
+        // A read under way will set the stamp; asking again would restart it. (A change
+        // seen meanwhile stays pending until it is done.)
+        if self.loading.is_some() || !self.file_watch.take_changed() {
             return;
         }
         if !self.disk_changed && self.doc.changed_on_disk() {
@@ -775,12 +774,7 @@ impl TracelabApp {
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let t0 = Instant::now();
         self.frame_inner(ui);
-        if std::env::var_os("TRACELAB_LOG_FRAMES").is_some() {
-            eprintln!(
-                "tracelab: ui code {:.1} ms",
-                t0.elapsed().as_secs_f64() * 1e3
-            );
-        }
+        log::info!(target: crate::logging::FRAMES, "ui code {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
     }
 
     fn frame_inner(&mut self, ui: &mut egui::Ui) {
@@ -907,9 +901,9 @@ impl TracelabApp {
         self.request_render(size);
         if !self.worker.is_idle() || self.loading.is_some() {
             ctx.request_repaint_after(Duration::from_millis(30));
-        } else {
-            // Keep watching the file on disk while idle.
-            ctx.request_repaint_after(Duration::from_secs(1));
+        } else if !self.file_watch.has_events() {
+            // No file events here: look at the file on disk now and then while idle.
+            ctx.request_repaint_after(file_watch::POLL_EVERY);
         }
     }
 }

@@ -5,6 +5,7 @@ pub mod app;
 pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
+pub mod file_watch;
 pub mod layout;
 pub mod loading;
 pub mod menu;

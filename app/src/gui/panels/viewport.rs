@@ -451,9 +451,10 @@ impl Viewport {
         }
         if p.job.generation != self.shown_generation {
             self.shown_generation = p.job.generation;
-            if std::env::var_os("TRACELAB_LOG_TIMES").is_some_and(|v| v != "0") {
-                eprintln!(
-                    "tracelab: generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
+            if log::log_enabled!(target: crate::logging::TIMES, log::Level::Info) {
+                log::info!(
+                    target: crate::logging::TIMES,
+                    "generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
                     p.job.generation,
                     p.job.submitted.elapsed().as_secs_f64() * 1e3,
                     ctx.input(|i| i.unstable_dt) * 1e3
