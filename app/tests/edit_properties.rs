@@ -232,7 +232,7 @@ fn check_save(d: &mut Document, seed: u64, step: usize) {
         Err(why) => {
             let incomplete: Vec<_> = check_scene(&d.scene).into_iter().filter(|p| p.incomplete).collect();
             assert!(!incomplete.is_empty(), "seed {s} step {t}: Save refuses a complete document: {why}");
-            assert!(why.contains(&incomplete[0].message), "seed {s} step {t}: {why}");
+            assert!(why.to_string().contains(&incomplete[0].message), "seed {s} step {t}: {why}");
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Edits as commands. Panels emit them; [`crate::document::Document::apply`] is the one place
 //! that carries them out (through [`apply_to`]) and records undo.
 
+use super::error::Misfit;
 use glam::Vec3;
 use tracelab_core::{
     Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene, TransformOp,
@@ -150,7 +151,7 @@ impl std::fmt::Display for Refusal {
 /// `scene` already has, which an edit does not answer for.
 pub fn apply_checked(scene: &Scene, known: &[Problem], edit: Edit) -> Result<(Scene, After, Vec<Problem>), Refusal> {
     let mut next = scene.clone();
-    let after = apply_to(&mut next, edit).map_err(Refusal::structural)?;
+    let after = apply_to(&mut next, edit).map_err(|m| Refusal::structural(m.0))?;
     let problems = check_scene(&next);
     if let Some(p) = problems.iter().find(|p| !p.incomplete && !known.contains(p)) {
         return Err(Refusal::broken(p));
@@ -168,7 +169,7 @@ pub enum After {
 
 /// Applies one edit to a scene. Never panics: an edit that does not fit the scene (a stale
 /// id, an index out of range, a move into its own subtree) is an error and changes nothing.
-pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, String> {
+pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
     let g = &mut scene.graph;
     // What every node rendered with, for edits that must keep their neighbours' colours.
     let before = g.effective_materials();
@@ -442,7 +443,7 @@ fn keep_list_colours(g: &mut Graph, list: NodeId, before: &[Option<u32>], except
 /// `node`, just put in a new place, sets its own material; if that place is inside a
 /// Transform, where no MaterialIndex can stand, the material moves up to the Transform the
 /// chain hangs from, the one listed in a Group or CSG node, whose other objects keep theirs.
-fn settle_material(g: &mut Graph, node: NodeId, before: &[Option<u32>]) -> Result<(), String> {
+fn settle_material(g: &mut Graph, node: NodeId, before: &[Option<u32>]) -> Result<(), Misfit> {
     let parents = g.parents();
     let parent_of = |id: NodeId| parents.get(id.index()).copied().flatten();
     let listed = |g: &Graph, id: NodeId| matches!(g.get(id).map(|n| &n.kind), Some(NodeKind::Group | NodeKind::Csg(_)));
@@ -469,7 +470,7 @@ fn settle_material(g: &mut Graph, node: NodeId, before: &[Option<u32>]) -> Resul
 fn transform_ops(
     g: &mut tracelab_core::Graph,
     node: NodeId,
-) -> Result<&mut Vec<TransformOp>, String> {
+) -> Result<&mut Vec<TransformOp>, Misfit> {
     match g.get_mut(node).map(|n| &mut n.kind) {
         Some(NodeKind::Transform(ops)) => Ok(ops),
         _ => Err("not a Transform".into()),
@@ -485,7 +486,7 @@ fn group_slot(
     root: NodeId,
     parent_of: &dyn Fn(NodeId) -> Option<NodeId>,
     g: &tracelab_core::Graph,
-) -> Result<NodeId, String> {
+) -> Result<NodeId, Misfit> {
     if node == root {
         return Err("the root Group cannot be moved or deleted".into());
     }

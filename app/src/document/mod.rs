@@ -7,6 +7,9 @@ use std::time::SystemTime;
 use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check_scene};
 
 pub mod edit;
+mod error;
+
+pub use error::{Misfit, OpenError, SaveError};
 
 use crate::io::{Opened, SceneRead, read_scene_file};
 use edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
@@ -261,14 +264,14 @@ impl Document {
     /// Opens a file now (blocking; the app reads files on a thread, see `crate::gui::loading`).
     /// A file that cannot be read at all leaves the current scene open and reports why;
     /// per-node errors (a missing OBJ) open the scene and report them.
-    pub fn open(&mut self, path: &Path) -> Result<(), String> {
+    pub fn open(&mut self, path: &Path) -> Result<(), OpenError> {
         let read = read_scene_file(path, std::mem::take(&mut self.mesh_cache));
         self.install(read)
     }
 
     /// Replaces the document by a scene read with [`read_scene_file`], adopting its mesh
     /// cache; a file that could not be read leaves the scene and reports why.
-    pub fn install(&mut self, read: SceneRead) -> Result<(), String> {
+    pub fn install(&mut self, read: SceneRead) -> Result<(), OpenError> {
         let SceneRead { path, outcome, cache } = read;
         match outcome {
             Ok(Opened { scene, messages, lost_comments }) => {
@@ -283,9 +286,8 @@ impl Document {
             }
             Err(messages) => {
                 self.mesh_cache = cache;
-                let text = messages.join("\n");
-                self.messages = messages;
-                Err(text)
+                self.messages = messages.clone();
+                Err(OpenError(messages))
             }
         }
     }
@@ -312,13 +314,13 @@ impl Document {
     ///
     /// Nothing is written while a node is incomplete or a rule is broken, or when the text
     /// would not read back as this document: the error says what to fix.
-    pub fn save_as(&mut self, path: &Path) -> Result<(), String> {
+    pub fn save_as(&mut self, path: &Path) -> Result<(), SaveError> {
         let (from, to) = (self.folder(), folder_of(path));
         let mut scene = self.scene.clone();
         tracelab_core::rebase_mesh_paths(&mut scene, &from, &to);
         let text = self.checked_text(&scene, path)?;
         crate::io::write_atomic(path, text.as_bytes())
-            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+            .map_err(|source| SaveError::Write { path: path.to_path_buf(), source })?;
         self.scene = scene;
         self.problems = check_scene(&self.scene);
         for s in self.undo.iter_mut().chain(self.redo.iter_mut()) {
@@ -334,7 +336,7 @@ impl Document {
 
     /// The text Save As `path` would write, or why it would write nothing (see
     /// [`Document::save_as`]); writes nothing itself.
-    pub fn text_for(&mut self, path: &Path) -> Result<String, String> {
+    pub fn text_for(&mut self, path: &Path) -> Result<String, SaveError> {
         let mut scene = self.scene.clone();
         tracelab_core::rebase_mesh_paths(&mut scene, &self.folder(), &folder_of(path));
         self.checked_text(&scene, path)
@@ -343,11 +345,11 @@ impl Document {
     /// The checked writer's text for `scene` (the document rebased for `path`), read back as
     /// the file at `path` would be (meshes are not loaded: what they are is not written), and
     /// required to be the same document.
-    fn checked_text(&mut self, scene: &Scene, path: &Path) -> Result<String, String> {
+    fn checked_text(&mut self, scene: &Scene, path: &Path) -> Result<String, SaveError> {
         let name = path.display().to_string();
-        let text = tracelab_core::try_write_scene(scene).map_err(|problems| {
-            let what: Vec<String> = problems.iter().map(|p| format!("  {}", p.message)).collect();
-            format!("{name}: not saved; first fix:\n{}", what.join("\n"))
+        let text = tracelab_core::try_write_scene(scene).map_err(|problems| SaveError::BreaksRules {
+            path: path.to_path_buf(),
+            fix: problems.into_iter().map(|p| p.message).collect(),
         })?;
         let back = tracelab_core::parse_scene_unresolved(text.as_bytes(), &name);
         let why = match back.scene {
@@ -356,15 +358,15 @@ impl Document {
             None => Some(format!("it would not open again:\n{}", back.diagnostics)),
         };
         match why {
-            Some(why) => Err(format!("{name}: not saved, because {why} (a tracelab bug; please report it)")),
+            Some(why) => Err(SaveError::WouldNotReadBack { path: path.to_path_buf(), why }),
             None => Ok(text),
         }
     }
 
-    pub fn save(&mut self) -> Result<(), String> {
+    pub fn save(&mut self) -> Result<(), SaveError> {
         match self.path.clone() {
             Some(p) => self.save_as(&p),
-            None => Err("the built-in scene has no file yet: use Save As".into()),
+            None => Err(SaveError::NoFile),
         }
     }
 
@@ -475,7 +477,7 @@ mod tests {
         let Some(Selection::Node(id)) = doc.selection else { panic!("the new node is selected") };
         let incomplete: Vec<_> = doc.incomplete().map(|p| (p.node(), p.reason.clone())).collect();
         assert_eq!(incomplete, [(Some(id), "TriangleMesh: no OBJ file chosen yet".to_string())]);
-        let e = doc.save().expect_err("nothing to write yet");
+        let e = doc.save().expect_err("nothing to write yet").to_string();
         assert!(e.contains("not saved") && e.contains("no OBJ file chosen yet"), "{e}");
         assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);
         // A name that cannot be written is refused outright; a missing file is only a node error.
@@ -527,7 +529,7 @@ mod tests {
         std::fs::write(&p, crate::DEFAULT_SCENE).expect("write");
         let mut doc = Document::builtin();
         doc.open(&p).expect("open");
-        let e = doc.save_as(&d.join("gone/scene.txt")).expect_err("no such folder");
+        let e = doc.save_as(&d.join("gone/scene.txt")).expect_err("no such folder").to_string();
         assert!(e.contains("cannot write"), "{e}");
         assert_eq!(doc.path.as_deref(), Some(p.as_path()));
         assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);

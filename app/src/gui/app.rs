@@ -223,7 +223,7 @@ impl TracelabApp {
                     "exported {}",
                     files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
                 )),
-                Err(e) => self.doc.messages.push(e),
+                Err(e) => self.doc.messages.push(e.to_string()),
             },
             AppCommand::Reload => self.reload(),
             AppCommand::Quit => self.quit(ctx),
@@ -406,7 +406,7 @@ impl TracelabApp {
                 true
             }
             Err(e) => {
-                self.doc.messages.push(e);
+                self.doc.messages.push(e.to_string());
                 false
             }
         }
@@ -414,13 +414,13 @@ impl TracelabApp {
 
     /// Writes what the view shows: one image, or one per view for "All three" (suffixes
     /// _color, _normals, _depth) and per rule in compare mode (_correct, _incorrect).
-    pub fn export(&mut self, path: &Path) -> Result<Vec<PathBuf>, String> {
+    pub fn export(&mut self, path: &Path) -> anyhow::Result<Vec<PathBuf>> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         if !matches!(ext.as_deref(), Some("png" | "tga")) {
-            return Err(format!("{}: export as .png or .tga", path.display()));
+            anyhow::bail!("{}: export as .png or .tga", path.display());
         }
         let cells = self.view.cells();
         let mut cells: Vec<(usize, tracelab_core::View, &str)> =
@@ -437,10 +437,10 @@ impl TracelabApp {
         let ext = ext.unwrap_or_default();
         let depth = self.view.depth;
         self.worker.with_published(|p| {
-            let p = p.ok_or("nothing rendered yet")?;
+            let p = p.ok_or_else(|| anyhow::anyhow!("nothing rendered yet"))?;
             let mut written = Vec::new();
             for (f, view, _) in &cells {
-                let frame = p.frames.get(*f).ok_or("no such frame")?.lock().clone();
+                let frame = p.frames.get(*f).ok_or_else(|| anyhow::anyhow!("no such frame"))?.lock().clone();
                 let target = if many {
                     let v = match view {
                         tracelab_core::View::Color => "color",

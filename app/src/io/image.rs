@@ -6,6 +6,17 @@ use tracelab_core::{Frame, View};
 
 use super::atomic::write_atomic;
 
+/// Why an image was not written (an existing file is left as it was).
+#[derive(Debug, thiserror::Error)]
+pub enum ImageWriteError {
+    #[error("{}: unknown image format (use .png, .tga, .ppm or .bmp)", .0.display())]
+    UnknownFormat(std::path::PathBuf),
+    #[error("{}: cannot encode image: {source}", .path.display())]
+    Encode { path: std::path::PathBuf, source: image::ImageError },
+    #[error("{}: cannot write image: {source}", .path.display())]
+    Write { path: std::path::PathBuf, source: std::io::Error },
+}
+
 /// Encodes one view of a frame in the format its extension names (see [`image_format`]),
 /// all in memory first so that a failed encode never touches an existing file, then writes
 /// it with [`write_atomic`].
@@ -14,16 +25,11 @@ pub fn write_image(
     view: View,
     depth: (f32, f32),
     path: &Path,
-) -> Result<(), String> {
-    let format = image_format(path).ok_or_else(|| {
-        format!(
-            "{}: unknown image format (use .png, .tga, .ppm or .bmp)",
-            path.display()
-        )
-    })?;
-    let bytes = encode_image(frame, view, depth, format)
-        .map_err(|e| format!("{}: cannot encode image: {e}", path.display()))?;
-    write_atomic(path, &bytes).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
+) -> Result<(), ImageWriteError> {
+    let p = || path.to_path_buf();
+    let format = image_format(path).ok_or_else(|| ImageWriteError::UnknownFormat(p()))?;
+    let bytes = encode_image(frame, view, depth, format).map_err(|source| ImageWriteError::Encode { path: p(), source })?;
+    write_atomic(path, &bytes).map_err(|source| ImageWriteError::Write { path: p(), source })
 }
 
 /// The image formats tracelab writes, from a file name's extension (any case).
@@ -128,7 +134,7 @@ mod tests {
         // TGA stores sides in 16 bits.
         let wide = Frame::new(70_000, 1);
         let e = write_image(&wide, View::Color, (0.0, 1.0), &p).expect_err("too wide for TGA");
-        assert!(e.contains("cannot encode image"), "{e}");
+        assert!(e.to_string().contains("cannot encode image"), "{e}");
         let empty = Frame::new(0, 0);
         for name in ["wide.tga", "e.png", "e.bmp", "e.ppm"] {
             assert!(

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use tracelab_core::{MeshCache, Scene};
 
 pub use atomic::write_atomic;
-pub use image::{encode_image, image_format, write_image};
+pub use image::{ImageWriteError, encode_image, image_format, write_image};
 
 use crate::exit::Exit;
 
