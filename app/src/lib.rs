@@ -11,6 +11,8 @@ pub mod gui;
 pub mod io;
 pub mod logging;
 pub mod render_worker;
+#[cfg(test)]
+mod test_support;
 
 /// The scene tracelab opens when started with no file.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.txt");

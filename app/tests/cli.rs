@@ -8,15 +8,11 @@ fn tracelab(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tracelab")).args(args).current_dir(dir).output().expect("run tracelab")
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tracelab-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
-}
+mod common;
+use common::repo;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+fn temp_dir(name: &str) -> PathBuf {
+    common::temp_dir("cli", name)
 }
 
 fn stderr(o: &Output) -> String {

@@ -12,8 +12,10 @@ use tracelab::document::Selection;
 use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
 
 
+mod common;
+
 fn repo(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+    common::repo().join(rel)
 }
 
 /// A course scene from ../shared. Tests that use one are `#[ignore]`d with the reason, so a
@@ -26,9 +28,7 @@ fn shared_scene(name: &str) -> PathBuf {
 }
 
 fn temp_dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tracelab-gui-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
+    common::temp_dir("gui", tag)
 }
 
 fn harness(scene: Option<PathBuf>, size: (u32, u32)) -> Harness<'static, TracelabApp> {

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
-use common::{Rng, fuzz_cases, mutate_text, quoted};
+use common::{Rng, fuzz_cases, mutate_text, quoted, repo};
 use tracelab_core::format::obj::{load_with_tobj, parse_obj, parse_obj_fast};
 use tracelab_core::{Frame, MeshCache, RenderSettings, Scene, check_scene, compile, parse_scene, render_frame, write_scene};
 
@@ -24,10 +24,6 @@ const CASE_LIMIT_MS: u64 = 20_000;
 
 const SCENE_SEED: u64 = 0x5eed_0f_5ce_9e5;
 const OBJ_SEED: u64 = 0x0b1_5eed_f00d;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn skip_note(msg: &str) {
     use std::io::Write as _;

@@ -2,19 +2,13 @@
 //! folders, FIFOs or symlink loops, files past the size cap. None may block or fill memory,
 //! and each is reported as what it is.
 
+mod common;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
 use tracelab_core::format::obj::{MAX_OBJ_BYTES, load_obj};
 use tracelab_core::{MeshCache, parse_scene};
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tracelab-hostile-obj-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 fn mkfifo(path: &Path) {
     let ok = std::process::Command::new("mkfifo").arg(path).status().is_ok_and(|s| s.success());
@@ -97,4 +91,8 @@ fn an_obj_over_the_size_cap_is_refused_before_parsing() {
     let e = load_obj(&big).expect_err("too big");
     assert_eq!(e.to_string(), "the file is larger than 512 MiB, the most tracelab reads as an OBJ mesh");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    common::temp_dir("hostile-obj", name)
 }

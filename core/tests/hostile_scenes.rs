@@ -2,6 +2,7 @@
 //! control bytes and numbers that do not fit. Each must give a short, located answer quickly
 //! and with bounded memory.
 
+mod common;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -12,12 +13,6 @@ const MAX_SCENE_BYTES: usize = 64 << 20;
 
 fn parse(text: &str) -> ParseOutcome {
     parse_scene(text.as_bytes(), "scene.txt", None, &mut MeshCache::new())
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tracelab-hostile-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
 }
 
 const HEAD: &str = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
@@ -180,4 +175,8 @@ fn a_mesh_under_a_huge_scale_renders_in_bounded_time() {
         let _ = tx.send(());
     });
     assert!(rx.recv_timeout(Duration::from_secs(20)).is_ok(), "the 4x4 render did not finish in 20 s");
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    common::temp_dir("hostile", name)
 }

@@ -4,6 +4,8 @@
 //! `TRACELAB_UPDATE_GOLDEN=1 cargo test -p tracelab-core --test lecture`, then look at
 //! every image again before committing it.
 
+mod common;
+use common::repo;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::{
@@ -45,10 +47,6 @@ const FIGURES: &[Figure] = &[
     fig("csg_subtraction", "csg_subtraction", Color, Correct),
     fig("csg_die", "csg_die", Color, Correct),
 ];
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn scene_path(name: &str) -> PathBuf {
     repo().join("scenes/lecture").join(format!("{name}.txt"))

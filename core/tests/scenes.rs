@@ -3,16 +3,14 @@
 //! write → read round trip unchanged, in the course's own grammar unless they use one of
 //! tracelab's extensions (scenes/lecture/ has Box and CSG scenes).
 
+mod common;
+use common::repo;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::format::uses_only_course_grammar;
 use tracelab_core::{
     Frame, MeshCache, NormalTransform, RenderSettings, Scene, check_scene, compile, load_scene, render_frame, write_scene,
 };
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn our_scenes() -> Vec<PathBuf> {
     scenes_in("scenes")

@@ -49,20 +49,16 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
     let frame = |buf: &mut Vec<f32>| {
         // The columns' share of every ray, once per frame (bit-identical to `pixel_ray`).
         let rays = compiled.camera.pixel_rays(w, h);
-        // One row buffer per rayon job, and jobs of at least 16 rows: with a fresh, growing
-        // buffer for every stolen row, 2 threads scaled 1.62-1.78x instead of 1.83-1.95x.
+        // One row buffer per rayon job, jobs of at least 16 rows: a fresh buffer per stolen
+        // row cost 2-thread scaling (docs/perf.md, "Figures behind the code's comments").
         let new_buf = || Vec::with_capacity(w as usize);
         buf.par_chunks_mut(w as usize)
             .enumerate()
             .with_min_len(16)
             .for_each_init(new_buf, |row_buf, (row, out)| {
                 // The row's rays first, in one tight loop, then the traversals: made between
-                // two traversals, each ray's square root and division (then its object-space
-                // transform and reciprocal) headed its own dependency chain. Stanford bunny
-                // 12.8 -> 15.6 Mrays/s, dragon 11.3 -> 13.5, bunny_1k 20.8 -> 29, cube 71 -> 65
-                // (1 thread, medians of 7, alternating runs). The progressive renderer shades
-                // between traversals, which hides that latency: the same change gained it
-                // nothing there.
+                // two traversals, each ray's set-up headed its own dependency chain
+                // (docs/perf.md).
                 rays.row(row as u32).fill(row_buf);
                 for (ray, t) in row_buf.iter().zip(out.iter_mut()) {
                     *t = compiled

@@ -390,12 +390,12 @@ fn modified(p: &Path) -> Option<SystemTime> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::names_in;
     use super::edit::Edit;
     use tracelab_core::NodeKind;
 
     fn temp_dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("tracelab-state-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
+        let d = crate::test_support::temp_dir("state", name);
         std::fs::create_dir_all(d.join("scenes")).expect("dirs");
         std::fs::create_dir_all(d.join("out/sub")).expect("dirs");
         d
@@ -455,14 +455,6 @@ mod tests {
     }
 
 
-    fn names_in(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .expect("read dir")
-            .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
-            .collect();
-        v.sort();
-        v
-    }
 
     #[test]
     fn an_incomplete_mesh_is_listed_and_keeps_save_from_writing_until_it_names_a_file() {

@@ -240,23 +240,12 @@ fn sync_dir(dir: &Path) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::names_in;
     #[cfg(unix)]
     use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 
     fn temp_dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("tracelab-io-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("temp dir");
-        d
-    }
-
-    fn names_in(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .expect("read dir")
-            .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
-            .collect();
-        v.sort();
-        v
+        crate::test_support::temp_dir("io", name)
     }
 
     /// A private device node in `dir` (never the machine's own /dev files); `None`, with a

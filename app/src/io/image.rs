@@ -95,22 +95,11 @@ pub fn encode_image(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::names_in;
     use std::path::PathBuf;
 
     fn temp_dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("tracelab-image-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("temp dir");
-        d
-    }
-
-    fn names_in(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .expect("read dir")
-            .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
-            .collect();
-        v.sort();
-        v
+        crate::test_support::temp_dir("image", name)
     }
 
     #[test]

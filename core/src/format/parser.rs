@@ -224,7 +224,7 @@ struct Field {
     comments: Vec<String>,
 }
 
-enum Frame {
+enum OpenBlock {
     Group {
         node: NodeId,
         open: usize,
@@ -877,13 +877,13 @@ impl<'a> Parser<'a> {
         let root = graph.root();
         graph.node_mut(root).comments.before = before;
         let mut stack =
-            vec![Frame::Group { node: root, open, declared: None, count: 0, material: None }];
+            vec![OpenBlock::Group { node: root, open, declared: None, count: 0, material: None }];
         while !stack.is_empty() {
             let Some(t) = self.next() else {
                 let (kind, open) = match stack.last() {
-                    Some(Frame::Group { open, .. }) => ("Group", *open),
-                    Some(Frame::Transform { open, .. }) => ("Transform", *open),
-                    Some(Frame::Csg { op, open, .. }) => (op.name(), *open),
+                    Some(OpenBlock::Group { open, .. }) => ("Group", *open),
+                    Some(OpenBlock::Transform { open, .. }) => ("Transform", *open),
+                    Some(OpenBlock::Csg { op, open, .. }) => (op.name(), *open),
                     None => break,
                 };
                 self.error(open, format!("unterminated {kind} block: expected \"}}\" before the end of the file"));
@@ -893,7 +893,7 @@ impl<'a> Parser<'a> {
                 TokKind::Close => {
                     if let Some(frame) = stack.pop() {
                         let node = match &frame {
-                            Frame::Group { node, .. } | Frame::Transform { node, .. } | Frame::Csg { node, .. } => *node,
+                            OpenBlock::Group { node, .. } | OpenBlock::Transform { node, .. } | OpenBlock::Csg { node, .. } => *node,
                         };
                         graph.node_mut(node).comments.end = self.comments_here();
                         self.close_frame(frame, &mut graph);
@@ -907,7 +907,7 @@ impl<'a> Parser<'a> {
                     let w = self.text(t);
                     if let Some(frame) = stack.last_mut() {
                         match frame {
-                            Frame::Group { node, declared, count, material, .. } => {
+                            OpenBlock::Group { node, declared, count, material, .. } => {
                                 let parent = *node;
                                 match w {
                                     "numObjects" => {
@@ -919,7 +919,7 @@ impl<'a> Parser<'a> {
                                             self.error(t.start, "numObjects is given twice in this Group");
                                         }
                                         let d = self.expect_count("numObjects");
-                                        if let Some(Frame::Group { declared, .. }) = stack.last_mut() {
+                                        if let Some(OpenBlock::Group { declared, .. }) = stack.last_mut() {
                                             *declared = d.or(*declared);
                                         }
                                     }
@@ -937,7 +937,7 @@ impl<'a> Parser<'a> {
                                         if let Some(m) = self.parse_material_block("Material", t.start) {
                                             self.materials.push(m);
                                             let idx = (self.materials.len() - 1) as u32;
-                                            if let Some(Frame::Group { material, .. }) = stack.last_mut() {
+                                            if let Some(OpenBlock::Group { material, .. }) = stack.last_mut() {
                                                 *material = Some(idx);
                                             }
                                         }
@@ -966,7 +966,7 @@ impl<'a> Parser<'a> {
                                     }
                                 }
                             }
-                            Frame::Transform { node, has_child, .. } => {
+                            OpenBlock::Transform { node, has_child, .. } => {
                                 let parent = *node;
                                 if OBJECT_KEYWORDS.contains(&w) {
                                     if *has_child {
@@ -980,7 +980,7 @@ impl<'a> Parser<'a> {
                                     let c = self.comments_here();
                                     let Some(op) = self.parse_op(w, t.start) else { continue };
                                     match stack.last_mut() {
-                                        Some(Frame::Transform { ops, has_child: false, .. }) => {
+                                        Some(OpenBlock::Transform { ops, has_child: false, .. }) => {
                                             if !c.is_empty() {
                                                 graph.node_mut(parent).comments.inner.entry(Anchor::Op(ops.len())).or_default().extend(c);
                                             }
@@ -990,14 +990,14 @@ impl<'a> Parser<'a> {
                                     }
                                 }
                             }
-                            Frame::Csg { node, op, count, material, .. } => {
+                            OpenBlock::Csg { node, op, count, material, .. } => {
                                 let (parent, op) = (*node, *op);
                                 if w == "MaterialIndex" {
                                     self.defer_comments();
                                     if let Some((i, at)) = self.expect_count("MaterialIndex") {
                                         let i = u32::try_from(i).unwrap_or(u32::MAX);
                                         self.material_refs.push((i, at));
-                                        if let Some(Frame::Csg { material, .. }) = stack.last_mut() {
+                                        if let Some(OpenBlock::Csg { material, .. }) = stack.last_mut() {
                                             *material = Some(i);
                                         }
                                     }
@@ -1129,7 +1129,7 @@ impl<'a> Parser<'a> {
         parent: NodeId,
         material: Option<u32>,
         graph: &mut Graph,
-    ) -> Option<Frame> {
+    ) -> Option<OpenBlock> {
         let before = self.comments_here();
         let open = self.expect_open(w)?;
         let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind, comments: Comments| {
@@ -1140,16 +1140,16 @@ impl<'a> Parser<'a> {
         };
         if let Some(op) = CsgOp::from_name(w) {
             let node = attach(self, graph, NodeKind::Csg(op), Comments { before, ..Comments::default() });
-            return Some(Frame::Csg { node, op, keyword: off, open, count: 0, material: None });
+            return Some(OpenBlock::Csg { node, op, keyword: off, open, count: 0, material: None });
         }
         match w {
             "Group" => {
                 let node = attach(self, graph, NodeKind::Group, Comments { before, ..Comments::default() });
-                Some(Frame::Group { node, open, declared: None, count: 0, material: None })
+                Some(OpenBlock::Group { node, open, declared: None, count: 0, material: None })
             }
             "Transform" => {
                 let node = attach(self, graph, NodeKind::Transform(Vec::new()), Comments { before, ..Comments::default() });
-                Some(Frame::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
+                Some(OpenBlock::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
             }
             _ => {
                 let (kind, mut comments) = self.parse_primitive(w, off, open)?;
@@ -1215,9 +1215,9 @@ impl<'a> Parser<'a> {
         Some((kind, comments))
     }
 
-    fn close_frame(&mut self, frame: Frame, graph: &mut Graph) {
+    fn close_frame(&mut self, frame: OpenBlock, graph: &mut Graph) {
         match frame {
-            Frame::Csg { node, op, keyword, count, .. } => {
+            OpenBlock::Csg { node, op, keyword, count, .. } => {
                 if count != 2 {
                     self.error(
                         keyword,
@@ -1229,11 +1229,11 @@ impl<'a> Parser<'a> {
                     self.check_operand(graph, c, op);
                 }
             }
-            Frame::Group { declared: Some((n, at)), count, .. } if n != count => {
+            OpenBlock::Group { declared: Some((n, at)), count, .. } if n != count => {
                 self.error(at, format!("numObjects says {n} but the Group holds {count} object(s)"));
             }
-            Frame::Group { .. } => {}
-            Frame::Transform { node, keyword, ops, has_child, .. } => {
+            OpenBlock::Group { .. } => {}
+            OpenBlock::Transform { node, keyword, ops, has_child, .. } => {
                 if !has_child {
                     self.error(keyword, "Transform needs one object after its operations");
                 }

@@ -168,8 +168,7 @@ impl CompiledScene {
     ///
     /// Inlined into the caller's pixel loop together with `mesh_hit`, so a one-mesh scene's
     /// ray goes from the registers it was made in to object space without a trip through
-    /// memory (each hop through a `Ray` in memory was a failed store forward: Stanford bunny
-    /// 12.1 -> 12.6 Mrays/s, medians of 7, same minute).
+    /// memory, where each hop was a failed store forward (docs/perf.md).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
         if let Some(i) = self.single_mesh
