@@ -2,15 +2,20 @@
 //! worker together.
 
 pub mod app;
+pub mod bounds;
 pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
+pub mod gizmo;
 pub mod layout;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
+pub mod navigation;
+pub mod overlays;
 pub mod panels;
 pub mod settings;
+pub mod view_tools;
 pub mod widgets;
 
 pub use app::{AppOptions, Pending, TracelabApp, run};
