@@ -2,8 +2,6 @@
 //! outline (from the per-pixel object ids that picking uses), a world-axes triad and the
 //! directional lights' directions.
 
-use std::collections::HashSet;
-
 use glam::Vec3;
 use tracelab_core::{Frame, NodeId, Scene};
 
@@ -11,15 +9,16 @@ use crate::gui::navigation::ViewBasis;
 
 const OUTLINE: [u8; 4] = [255, 150, 20, 255];
 
-/// The outline of the pixels showing `nodes` (raw node ids): each such pixel with a
-/// neighbour that shows something else, as an RGBA image the size of the frame (clear
-/// elsewhere). `None` when no pixel shows them.
-pub fn outline(frame: &Frame, nodes: &HashSet<u32>) -> Option<egui::ColorImage> {
+/// The outline of the pixels showing the nodes marked in `nodes` (indexed by raw node id):
+/// each such pixel with a neighbour that shows something else, as an RGBA image the size of
+/// the frame (clear elsewhere). `None` when no pixel shows them.
+pub fn outline(frame: &Frame, nodes: &[bool]) -> Option<egui::ColorImage> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    if w == 0 || h == 0 || nodes.is_empty() {
+    if w == 0 || h == 0 || !nodes.contains(&true) {
         return None;
     }
-    let inside: Vec<bool> = frame.samples.iter().map(|s| nodes.contains(&s.node)).collect();
+    // A table, not a set: this runs over every pixel on the UI thread.
+    let inside: Vec<bool> = frame.samples.iter().map(|s| nodes.get(s.node as usize).copied().unwrap_or(false)).collect();
     let at = |x: usize, y: usize| inside.get(y * w + x).copied().unwrap_or(false);
     let mut rgba = vec![0u8; w * h * 4];
     let mut any = false;
@@ -38,9 +37,15 @@ pub fn outline(frame: &Frame, nodes: &HashSet<u32>) -> Option<egui::ColorImage> 
     any.then(|| egui::ColorImage::from_rgba_unmultiplied([w, h], &rgba))
 }
 
-/// Raw ids of `node` and everything under it: what its pixels may name.
-pub fn subtree_ids(scene: &Scene, node: NodeId) -> HashSet<u32> {
-    scene.graph.preorder_from(node).into_iter().map(|id| id.index() as u32).collect()
+/// `node` and everything under it, marked by raw id: what its pixels may name.
+pub fn subtree_ids(scene: &Scene, node: NodeId) -> Vec<bool> {
+    let mut mask = vec![false; scene.graph.capacity_len()];
+    for id in scene.graph.preorder_from(node) {
+        if let Some(m) = mask.get_mut(id.index()) {
+            *m = true;
+        }
+    }
+    mask
 }
 
 /// A world direction as a screen vector (points, y down), as seen by the camera.
@@ -102,11 +107,15 @@ mod tests {
                 f.samples[y * 5 + x] = Sample { node: 7, ..Sample::UNSET };
             }
         }
-        let img = outline(&f, &HashSet::from([7])).expect("drawn");
+        let mut seven = vec![false; 9];
+        seven[7] = true;
+        let img = outline(&f, &seven).expect("drawn");
         let lit: Vec<usize> = img.pixels.iter().enumerate().filter(|(_, c)| c.a() > 0).map(|(i, _)| i).collect();
         // The 3×3 block's ring of 8, not its centre.
         assert_eq!(lit.len(), 8);
         assert!(!lit.contains(&12));
-        assert!(outline(&f, &HashSet::from([8])).is_none());
+        let mut eight = vec![false; 9];
+        eight[8] = true;
+        assert!(outline(&f, &eight).is_none());
     }
 }

@@ -161,7 +161,8 @@ pub struct Viewport {
     shown_generation: u64,
     /// Orbit, pan, zoom and the gizmo's drags.
     pub tools: ViewTools,
-    /// The selection's outline, and what it was made from (request, frame version, ids).
+    /// The selection's outline, and what it was made from (request, passes, selection,
+    /// generation).
     outline: Option<egui::TextureHandle>,
     outline_key: Option<(u64, u64, Option<Selection>, u64)>,
 }
@@ -428,8 +429,10 @@ impl Viewport {
 
     /// The outline of the selection, made again when the pixels or the selection change.
     fn upload_outline(&mut self, ctx: &egui::Context, p: &Published, doc: &Document) {
-        let Some(frame) = p.frames.first() else { return };
-        let key = Some((p.job.request, frame.version(), doc.selection, doc.generation));
+        // The image on screen stays the previous one until a pass is done; so does its outline.
+        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else { return };
+        // Once a pass, not once a tile: it runs over every pixel.
+        let key = Some((p.job.request, p.passes_done as u64, doc.selection, doc.generation));
         if self.outline_key == key {
             return;
         }
