@@ -85,8 +85,15 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
         let v = on_screen(basis, d) * 20.0;
         // Into the screen: a cross; out of it: a dot (the light is behind the viewer).
         if v.length() < 4.0 {
-            let t = if d.dot(basis.direction) > 0.0 { "⊗" } else { "⊙" };
-            painter.text(o, egui::Align2::CENTER_CENTER, t, egui::FontId::proportional(16.0), colour);
+            // Drawn, not typed: the UI's fonts have no ⊗ or ⊙.
+            let stroke = egui::Stroke::new(2.0, colour);
+            painter.circle_stroke(o, 7.0, stroke);
+            if d.dot(basis.direction) > 0.0 {
+                painter.line_segment([o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)], stroke);
+                painter.line_segment([o + egui::vec2(-5.0, 5.0), o + egui::vec2(5.0, -5.0)], stroke);
+            } else {
+                painter.circle_filled(o, 2.5, colour);
+            }
         } else {
             painter.arrow(o - v * 0.5, v, egui::Stroke::new(2.0, colour));
         }
