@@ -8,7 +8,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::render_progressive;
+use tracelab_core::render::{render_coarse, render_progressive};
 use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
 
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
@@ -23,6 +23,8 @@ pub struct Job {
     pub modes: Vec<NormalTransform>,
     /// When the edit that caused this job happened (for edit→image timings).
     pub submitted: Instant,
+    /// Only the coarse passes (the view is being dragged).
+    pub coarse: bool,
 }
 
 /// The render the UI should show.
@@ -51,7 +53,10 @@ pub struct RenderWorker {
     thread: Option<std::thread::JoinHandle<()>>,
     last_generation: u64,
     requests: u64,
-    last_key: Option<(u32, u32, bool, Vec<NormalTransform>)>,
+    last_key: Option<(u32, u32, bool, Vec<NormalTransform>, bool)>,
+    /// Render only the coarse passes from now on (the view is being dragged); a request with
+    /// this off renders the same generation again in full.
+    pub coarse_only: bool,
 }
 
 impl Default for RenderWorker {
@@ -77,6 +82,7 @@ impl RenderWorker {
             last_generation: 0,
             requests: 0,
             last_key: None,
+            coarse_only: false,
         }
     }
 
@@ -103,6 +109,7 @@ impl RenderWorker {
             settings.height,
             settings.shade_back,
             modes.clone(),
+            self.coarse_only,
         );
         if generation == self.last_generation && self.last_key.as_ref() == Some(&key) {
             return false;
@@ -120,6 +127,7 @@ impl RenderWorker {
             settings,
             modes,
             submitted: Instant::now(),
+            coarse: self.coarse_only,
         };
         if let Some(tx) = &self.tx {
             let _ = tx.send((job, self.cancel.clone()));
@@ -237,10 +245,12 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 normal_transform: job.modes[i],
                 ..job.settings
             };
-            render_progressive(&compiled, &settings, &frames[i], &cancel, |info| {
-                on_pass(i, info.passes)
-            })
-            .is_ok()
+            let pass = |info: tracelab_core::render::PassInfo| on_pass(i, info.passes);
+            if job.coarse {
+                render_coarse(&compiled, &settings, &frames[i], &cancel, pass).is_ok()
+            } else {
+                render_progressive(&compiled, &settings, &frames[i], &cancel, pass).is_ok()
+            }
         };
         let ok = if frames.len() == 2 {
             let (a, b) = rayon::join(|| render_one(0), || render_one(1));
@@ -252,11 +262,12 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_ref().inspect(|p| {
                 log::info!(
                     target: crate::logging::TIMES,
-                    "generation {} {}x{}{}: edit to first image {:.1} ms, to full refinement {:.1} ms",
+                    "generation {} {}x{}{}{}: edit to first image {:.1} ms, to full refinement {:.1} ms",
                     p.job.generation,
                     p.job.settings.width,
                     p.job.settings.height,
                     if p.frames.len() > 1 { " (compare)" } else { "" },
+                    if p.job.coarse { " (coarse, dragging)" } else { "" },
                     p.first_image.unwrap_or_default().as_secs_f64() * 1e3,
                     p.full.unwrap_or_default().as_secs_f64() * 1e3,
                 );

@@ -138,6 +138,19 @@ fn bench_progressive_reports_coarse_before_full() {
 }
 
 #[test]
+fn bench_progressive_times_a_camera_orbit_per_step() {
+    let d = quad_scene("orbit");
+    let o = tracelab(&["bench-progressive", "quad.txt", "--size", "64", "64", "--repeat", "1", "--orbit", "6"], &d);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let last = out.lines().last().unwrap_or_default();
+    assert!(last.starts_with("ORBIT steps=6 "), "last line: {last:?}");
+    let (first, coarse, full) = (field(last, "first_ms"), field(last, "coarse_ms"), field(last, "full_ms"));
+    assert!(first > 0.0 && first <= coarse && coarse <= full * 1.5 + 1.0, "{last}");
+    assert!(field(last, "max_first_ms") >= first);
+}
+
+#[test]
 fn bench_of_a_missing_scene_fails_with_its_name() {
     let d = quad_scene("missing");
     let o = tracelab(&["bench", "nope.txt"], &d);

@@ -43,6 +43,11 @@ pub struct ProgressiveArgs {
     pub threads: Option<usize>,
     #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
     pub repeat: usize,
+    /// Also time a camera orbit of this many steps (a full turn about the scene's centre),
+    /// as a middle-drag in the editor makes them: per step, the time to the first (coarse)
+    /// image and to the full one.
+    #[arg(long, allow_negative_numbers = true)]
+    pub orbit: Option<usize>,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -5,7 +5,12 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use tracelab_core::render::SharedFrame;
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, render_progressive};
+use glam::Vec3;
+use tracelab_core::render::render_coarse;
+use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, render_progressive};
+
+use crate::gui::bounds::world_bounds;
+use crate::gui::navigation::orbit;
 
 use super::{ProgressiveArgs, median};
 use crate::exit::check_size;
@@ -49,5 +54,52 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         runs.len()
     );
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
+    if let Some(steps) = b.orbit {
+        run_orbit(&scene, &settings, steps.max(1))?;
+    }
+    Ok(())
+}
+
+/// A turn of the camera about the scene's centre in `steps` steps, each as the editor
+/// renders a mouse move: the scene copied with the new camera, compiled, then the coarse
+/// passes (what is shown while the mouse moves) and, separately, the full progressive render
+/// (what the view refines to when it stops). Medians over the steps.
+fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::Result<()> {
+    let root = scene.graph.root();
+    let pivot = world_bounds(scene, root).map_or(Vec3::ZERO, |(a, b)| (a + b) * 0.5);
+    let target = SharedFrame::new();
+    let never = AtomicBool::new(false);
+    let step_scene = |k: usize| {
+        let mut s = scene.clone();
+        s.camera = orbit(&scene.camera, pivot, 360.0 * k as f32 / steps as f32, 0.0);
+        s
+    };
+    let mut first = Vec::new();
+    let mut coarse_done = Vec::new();
+    let mut full = Vec::new();
+    for k in 1..=steps {
+        let start = Instant::now();
+        let compiled = CompiledScene::new(&step_scene(k));
+        let mut t_first = None;
+        let mut t_last = Duration::ZERO;
+        let _ = render_coarse(&compiled, settings, &target, &never, |_| {
+            t_first.get_or_insert(start.elapsed());
+            t_last = start.elapsed();
+        });
+        first.push(t_first.unwrap_or(t_last).as_secs_f64() * 1e3);
+        coarse_done.push(t_last.as_secs_f64() * 1e3);
+        let start = Instant::now();
+        let compiled = CompiledScene::new(&step_scene(k));
+        let mut t_full = Duration::ZERO;
+        let _ = render_progressive(&compiled, settings, &target, &never, |_| t_full = start.elapsed());
+        full.push(t_full.as_secs_f64() * 1e3);
+    }
+    out!(
+        "ORBIT steps={steps} first_ms={:.2} coarse_ms={:.2} full_ms={:.2} max_first_ms={:.2}",
+        median(first.clone()),
+        median(coarse_done),
+        median(full),
+        first.iter().copied().fold(0.0, f64::max)
+    );
     Ok(())
 }

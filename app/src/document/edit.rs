@@ -3,6 +3,7 @@
 
 use super::error::Misfit;
 use glam::Vec3;
+use super::op_target::{OpKind, op_target};
 use tracelab_core::{
     Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene, TransformOp,
     check_scene,
@@ -87,6 +88,14 @@ pub enum Edit {
         light: Light,
     },
     SetBackground(Background),
+    /// A gizmo drag: sets the op of `op`'s kind (Translate, Scale or ZRotate) of the
+    /// Transform that moves `node`, adding the op, or a Transform around the node, first
+    /// when there is none (see `op_target`). The first edit of a drag adds; the following
+    /// ones find what it added, so the whole drag is one undo step.
+    SetOpOfKind {
+        node: NodeId,
+        op: TransformOp,
+    },
 }
 
 /// Edits with the same key that follow each other (one drag) make a single undo step.
@@ -98,6 +107,7 @@ pub enum CoalesceKey {
     Camera,
     Light(usize),
     Background,
+    OpOfKind(NodeId, OpKind),
 }
 
 impl Edit {
@@ -109,6 +119,7 @@ impl Edit {
             Edit::SetCamera(_) => Some(CoalesceKey::Camera),
             Edit::SetLight { index, .. } => Some(CoalesceKey::Light(*index)),
             Edit::SetBackground(_) => Some(CoalesceKey::Background),
+            Edit::SetOpOfKind { node, op } => OpKind::of(op).map(|k| CoalesceKey::OpOfKind(*node, k)),
             _ => None,
         }
     }
@@ -186,7 +197,8 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
         | Edit::MoveOp { node, .. }
         | Edit::SetNodeKind { node, .. }
         | Edit::SetNodeMaterial { node, .. }
-        | Edit::SwapOperands { node } => Some(*node),
+        | Edit::SwapOperands { node }
+        | Edit::SetOpOfKind { node, .. } => Some(*node),
         _ => None,
     };
     if target.is_some_and(|id| !reachable(id)) {
@@ -418,6 +430,29 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
                 .ok_or("no such light")? = light;
         }
         Edit::SetBackground(b) => scene.background = b,
+        Edit::SetOpOfKind { node, op } => {
+            let kind = OpKind::of(&op).ok_or("the gizmo drags Translate, Scale or ZRotate")?;
+            let target = op_target(g, node, kind)?;
+            let t = match target.transform {
+                Some(t) => t,
+                None => {
+                    apply_to(scene, Edit::WrapInTransform { node })?;
+                    let g = &scene.graph;
+                    g.parents().get(node.index()).copied().flatten().ok_or("not in the scene")?
+                }
+            };
+            let g = &mut scene.graph;
+            let ops = transform_ops(g, t)?;
+            if target.exists {
+                *ops.get_mut(target.index).ok_or("no such op")? = op;
+            } else {
+                let at = target.index.min(ops.len());
+                let last = ops.len();
+                ops.insert(at, op);
+                // Comments of the ops after it stay with them.
+                g.node_mut(t).comments.move_op(last, at);
+            }
+        }
     }
     Ok(After::Keep)
 }

@@ -7,6 +7,7 @@ use std::time::SystemTime;
 use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check_scene};
 
 pub mod edit;
+pub mod op_target;
 mod error;
 
 pub use error::{Misfit, OpenError, SaveError};
@@ -204,6 +205,27 @@ impl Document {
             state_id: self.state_id,
         });
         self.state_id = next.state_id;
+        self.after_history_move();
+        true
+    }
+
+    /// Names the present state, for [`Document::revert_to`].
+    pub fn history_mark(&self) -> u64 {
+        self.state_id
+    }
+
+    /// Takes back every step made since `mark` without leaving them to redo: Esc during a
+    /// drag, which then never happened. False (and nothing changes) when `mark` is not in
+    /// the history or is the present state.
+    pub fn revert_to(&mut self, mark: u64) -> bool {
+        if self.state_id == mark || !self.undo.iter().any(|s| s.state_id == mark) {
+            return false;
+        }
+        while self.state_id != mark {
+            let Some(prev) = self.undo.pop() else { break };
+            self.scene = prev.scene;
+            self.state_id = prev.state_id;
+        }
         self.after_history_move();
         true
     }

@@ -10,6 +10,9 @@ use tracelab_core::Scene;
 use tracelab_core::render::RayStory;
 
 use crate::document::edit::Edit;
+use crate::document::op_target::{OpKind, op_target};
+use crate::gui::{bounds, navigation};
+use glam::Vec3;
 use crate::gui::loading::{LoadPurpose, Loading};
 use crate::render_worker::RenderWorker;
 use crate::document::{Document, Selection};
@@ -19,6 +22,7 @@ use crate::gui::file_dialog::{FileDialog, Purpose};
 use crate::gui::layout::Layout;
 use crate::gui::file_watch::{self, FileWatch};
 use crate::gui::menu;
+use crate::gui::view_tools;
 use crate::gui::settings::Settings;
 use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::panels::pixel_inspector::Inspected;
@@ -91,6 +95,10 @@ pub struct TracelabApp {
     pub show_timings: bool,
     /// What the UI asked for this frame, carried out by [`Self::run_commands`].
     commands: Vec<AppCommand>,
+    /// A note for the status bar (what a gizmo drag added), and when it was made.
+    pub note: Option<(String, Instant)>,
+    /// The size the view renders at, for framing.
+    render_size: (u32, u32),
 }
 
 impl TracelabApp {
@@ -123,6 +131,8 @@ impl TracelabApp {
             show_timings: true,
             tree_seen: None,
             commands: Vec::new(),
+            note: None,
+            render_size: (1, 1),
         };
         if let Some(cc) = cc {
             let ctx = cc.egui_ctx.clone();
@@ -199,6 +209,7 @@ impl TracelabApp {
     fn run_command(&mut self, command: AppCommand, ctx: &egui::Context) {
         match command {
             AppCommand::Select(s) => self.doc.select(s),
+            AppCommand::Edit(Edit::SetOpOfKind { node, op }) => self.gizmo_edit(node, op),
             AppCommand::Edit(e) => self.apply(e),
             AppCommand::LoadMesh { node, obj_file } => {
                 if let Err(e) = self.doc.load_mesh(node, obj_file) {
@@ -235,6 +246,47 @@ impl TracelabApp {
             }
             AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
             AppCommand::ResetLayout => self.layout.reset(),
+            AppCommand::FrameSelected => match self.doc.selection {
+                Some(Selection::Node(id)) => self.frame_node(id),
+                _ => self.doc.messages.push("Frame selected: select an object first".into()),
+            },
+            AppCommand::FrameAll => self.frame_node(self.doc.scene.graph.root()),
+            AppCommand::AxisView(v) => {
+                let root = self.doc.scene.graph.root();
+                let (lo, hi) = bounds::world_bounds(&self.doc.scene, root).unwrap_or((Vec3::splat(-1.0), Vec3::ONE));
+                let (w, h) = self.render_size;
+                self.apply(Edit::SetCamera(navigation::axis_view(&self.doc.scene.camera, v, lo, hi, w, h)));
+            }
+            AppCommand::CancelDrag { mark } => {
+                self.doc.revert_to(mark);
+            }
+        }
+    }
+
+    /// Moves the camera, along its own direction, to show `node` whole.
+    fn frame_node(&mut self, node: tracelab_core::NodeId) {
+        match bounds::world_bounds(&self.doc.scene, node) {
+            Some((lo, hi)) => {
+                let (w, h) = self.render_size;
+                self.apply(Edit::SetCamera(navigation::frame(&self.doc.scene.camera, lo, hi, w, h)));
+            }
+            None => self.doc.messages.push("nothing with bounds to frame there (a plane has none)".into()),
+        }
+    }
+
+    /// A gizmo drag's edit; the status bar says what its first step added.
+    fn gizmo_edit(&mut self, node: tracelab_core::NodeId, op: tracelab_core::TransformOp) {
+        let added = OpKind::of(&op).and_then(|kind| {
+            let target = op_target(&self.doc.scene.graph, node, kind).ok()?;
+            let name = self.doc.scene.graph.get(node)?.kind.name();
+            target.added(kind, name)
+        });
+        if self.doc.apply(Edit::SetOpOfKind { node, op }).is_ok() {
+            if let Some(a) = added {
+                self.note = Some((a, Instant::now()));
+            }
+        } else if let Some(r) = &self.doc.refusal {
+            self.doc.messages.push(format!("edit refused: {r}"));
         }
     }
 
@@ -500,6 +552,8 @@ impl TracelabApp {
     /// Starts (or keeps) the render for the current document and view.
     pub fn request_render(&mut self, size: (u32, u32)) {
         let settings = Viewport::settings(&self.view, size);
+        // While the view is being dragged, coarse passes only; the full image once it stops.
+        self.worker.coarse_only = self.viewport.tools.moving();
         let scene = &self.doc.scene;
         self.worker.request(
             self.doc.generation,
@@ -563,6 +617,14 @@ impl TracelabApp {
                 if ui.checkbox(&mut open, "Pixel inspector").changed() {
                     out.push(AppCommand::ShowPixelInspector(open));
                 }
+                ui.separator();
+                let node = matches!(self.doc.selection, Some(Selection::Node(_)));
+                menu::button(ui, node, AppCommand::FrameSelected, &mut out);
+                menu::button(ui, true, AppCommand::FrameAll, &mut out);
+                for v in [navigation::AxisView::Front, navigation::AxisView::Right, navigation::AxisView::Top] {
+                    menu::button(ui, true, AppCommand::AxisView(v), &mut out);
+                }
+                ui.separator();
                 if menu::button(ui, true, AppCommand::ResetLayout, &mut out)
                     .on_hover_text("Panels back to their first sizes")
                     .clicked()
@@ -803,7 +865,8 @@ impl TracelabApp {
         if ctx.input(|i| i.viewport().close_requested()) && self.loading.is_some() {
             self.cancel_loading();
         }
-        if !ctx.input(|i| i.pointer.any_down()) {
+        // A drag, or a burst of wheel notches, is one undo step.
+        if !ctx.input(|i| i.pointer.any_down()) && !self.viewport.tools.wheel_busy() {
             self.doc.end_gesture();
         }
         if self.doc.generation != self.panels_generation {
@@ -836,7 +899,8 @@ impl TracelabApp {
         });
         self.run_commands(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| {
-            status::ui(ui, &self.doc, &self.worker, self.rows.2, self.show_timings)
+            let note = self.note.as_ref().filter(|(_, t)| t.elapsed() < Duration::from_secs(10)).map(|(n, _)| n.as_str());
+            status::ui(ui, &self.doc, &self.worker, self.rows.2, self.show_timings, note)
         });
         let mut asked: Vec<AppCommand> = Vec::new();
         let total = ui.available_rect_before_wrap().width();
@@ -887,8 +951,9 @@ impl TracelabApp {
             Viewport::toolbar(ui, &mut self.view);
             ui.separator();
             size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
+            self.render_size = size;
             self.request_render(size);
-            pick = self.viewport.images(ui, &mut self.view, &self.worker);
+            pick = self.viewport.images(ui, &mut self.view, &self.worker, &self.doc, &mut asked);
         });
         self.commands.extend(asked);
         if let Some(p) = pick {
@@ -899,7 +964,10 @@ impl TracelabApp {
         // Edits and dialogs above changed the document after the view asked for its render:
         // start the new one now, not on the next input event.
         self.request_render(size);
-        if !self.worker.is_idle() || self.loading.is_some() {
+        if self.viewport.tools.dragging() || self.viewport.tools.wheel_busy() {
+            // Notice when the pointer stops, to refine.
+            ctx.request_repaint_after(view_tools::STILL_AFTER / 2);
+        } else if !self.worker.is_idle() || self.loading.is_some() {
             ctx.request_repaint_after(Duration::from_millis(30));
         } else if !self.file_watch.has_events() {
             // No file events here: look at the file on disk now and then while idle.

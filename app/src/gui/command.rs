@@ -8,6 +8,7 @@ use tracelab_core::NodeId;
 
 use crate::document::Selection;
 use crate::document::edit::Edit;
+use crate::gui::navigation::AxisView;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum AppCommand {
@@ -39,6 +40,14 @@ pub enum AppCommand {
     Redo,
     ShowPixelInspector(bool),
     ResetLayout,
+    /// Move the camera to show the selected node whole (F).
+    FrameSelected,
+    /// Move the camera to show the whole scene (Home).
+    FrameAll,
+    /// Look along an axis, the scene framed (1, 3, 7 as Blender's numpad).
+    AxisView(AxisView),
+    /// Esc during a drag in the view: back to the state `mark` (see `Document::revert_to`).
+    CancelDrag { mark: u64 },
 }
 
 impl AppCommand {

@@ -4,6 +4,7 @@
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 use crate::gui::command::AppCommand;
+use crate::gui::navigation::AxisView;
 
 pub struct Entry {
     pub command: AppCommand,
@@ -40,6 +41,11 @@ pub static ENTRIES: &[Entry] = &[
     },
     Entry { command: AppCommand::ResetLayout, label: "Reset layout", keys: &[], keys_text: "" },
     Entry { command: AppCommand::DeleteSelected, label: "Delete", keys: &[keys(Modifiers::NONE, Key::Delete)], keys_text: "Del" },
+    Entry { command: AppCommand::FrameSelected, label: "Frame selected", keys: &[keys(Modifiers::NONE, Key::F)], keys_text: "F" },
+    Entry { command: AppCommand::FrameAll, label: "Frame all", keys: &[keys(Modifiers::NONE, Key::Home)], keys_text: "Home" },
+    Entry { command: AppCommand::AxisView(AxisView::Front), label: "Front view", keys: &[keys(Modifiers::NONE, Key::Num1)], keys_text: "1" },
+    Entry { command: AppCommand::AxisView(AxisView::Right), label: "Side view (right)", keys: &[keys(Modifiers::NONE, Key::Num3)], keys_text: "3" },
+    Entry { command: AppCommand::AxisView(AxisView::Top), label: "Top view", keys: &[keys(Modifiers::NONE, Key::Num7)], keys_text: "7" },
 ];
 
 /// The table's entry for a command.

@@ -2,16 +2,21 @@
 //! worker together.
 
 pub mod app;
+pub mod bounds;
 pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
 pub mod file_watch;
+pub mod gizmo;
 pub mod layout;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
+pub mod navigation;
+pub mod overlays;
 pub mod panels;
 pub mod settings;
+pub mod view_tools;
 pub mod widgets;
 
 pub use app::{AppOptions, Pending, TracelabApp, run};

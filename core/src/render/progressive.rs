@@ -106,6 +106,18 @@ pub fn render_progressive(
     render_scales(scene, settings, target, cancel, &SCALES, &mut on_pass)
 }
 
+/// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
+/// while the mouse drags the view, refining once it stops.
+pub fn render_coarse(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    target: &SharedFrame,
+    cancel: &AtomicBool,
+    mut on_pass: impl FnMut(PassInfo),
+) -> Result<(), Cancelled> {
+    render_scales(scene, settings, target, cancel, &SCALES[..2], &mut on_pass)
+}
+
 /// Renders the full-resolution image in one pass.
 pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
     let target = SharedFrame::new();

@@ -10,6 +10,7 @@ pub fn ui(
     worker: &RenderWorker,
     stats: (usize, usize, usize),
     timings: bool,
+    note: Option<&str>,
 ) {
     ui.horizontal(|ui| {
         worker.with_published(|p| match p {
@@ -49,5 +50,9 @@ pub fn ui(
         }
         ui.separator();
         ui.label(format!("generation {}", doc.generation));
+        if let Some(n) = note {
+            ui.separator();
+            ui.label(n);
+        }
     });
 }

@@ -5,6 +5,12 @@
 use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size};
 use tracelab_core::{NormalTransform, RenderSettings, View};
 
+use crate::document::{Document, Selection};
+use crate::gui::command::AppCommand;
+use crate::gui::gizmo::Axes;
+use crate::gui::navigation::OnScreen;
+use crate::gui::overlays;
+use crate::gui::view_tools::ViewTools;
 use crate::render_worker::{Published, RenderWorker};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -34,6 +40,10 @@ pub struct ViewSettings {
     pub fixed_size: Option<(u32, u32)>,
     /// Split position in compare-split mode, 0..1 from the left.
     pub split: f32,
+    /// The gizmo's arrows along the world's axes or the Translate's own.
+    pub gizmo_axes: Axes,
+    /// Draw the gizmo and the overlays (outline, axes, lights).
+    pub overlays: bool,
 }
 
 impl Default for ViewSettings {
@@ -46,6 +56,8 @@ impl Default for ViewSettings {
             depth: (8.0, 18.0),
             fixed_size: None,
             split: 0.5,
+            gizmo_axes: Axes::World,
+            overlays: true,
         }
     }
 }
@@ -147,6 +159,12 @@ pub struct Viewport {
     pub marker: Option<(u32, u32)>,
     /// Generation of the image on screen, for the edit→screen timing log.
     shown_generation: u64,
+    /// Orbit, pan, zoom and the gizmo's drags.
+    pub tools: ViewTools,
+    /// The selection's outline, and what it was made from (request, passes, selection,
+    /// generation).
+    outline: Option<egui::TextureHandle>,
+    outline_key: Option<(u64, u64, Option<Selection>, u64)>,
 }
 
 impl Viewport {
@@ -190,6 +208,14 @@ impl Viewport {
                 });
         });
         ui.horizontal_wrapped(|ui| {
+            ui.checkbox(&mut s.overlays, "gizmo & overlays");
+            ui.add_enabled_ui(s.overlays, |ui| {
+                ui.selectable_value(&mut s.gizmo_axes, Axes::World, "world axes")
+                    .on_hover_text("The gizmo's arrows move along the world's x, y and z");
+                ui.selectable_value(&mut s.gizmo_axes, Axes::Local, "local axes")
+                    .on_hover_text("The gizmo's arrows move along the Translate's own axes (its Transform's space)");
+            });
+            ui.separator();
             ui.checkbox(&mut s.shade_back, "shade back");
             ui.separator();
             ui.label("depth");
@@ -254,23 +280,32 @@ impl Viewport {
         (w as u32, h as u32)
     }
 
-    /// Draws the images and returns a pick when the user clicked a pixel.
+    /// Draws the images with the gizmo and overlays, queues what the mouse tools ask for,
+    /// and returns a pick when the user clicked a pixel.
     pub fn images(
         &mut self,
         ui: &mut egui::Ui,
         s: &mut ViewSettings,
         worker: &RenderWorker,
+        doc: &Document,
+        out: &mut Vec<AppCommand>,
     ) -> Option<Pick> {
         let cells = s.cells();
         let ctx = ui.ctx().clone();
         let mut pick = None;
         self.drawn.clear();
+        self.tools.begin_frame();
         worker.with_published(|p| {
             let Some(p) = p else {
                 ui.label("Rendering…");
                 return;
             };
             self.upload(&ctx, p, s);
+            if s.overlays {
+                self.upload_outline(&ctx, p, doc);
+            } else {
+                self.outline = None;
+            }
         });
         let avail = ui.available_size();
         let n = cells.len() as f32;
@@ -345,7 +380,20 @@ impl Viewport {
                     ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
                     self.drawn.push(Drawn { texture: tex_i, rect, uv });
                 }
-                let _ = ci;
+                let view = OnScreen::new(&doc.scene.camera, w as u32, h as u32, rect);
+                let surface = |px: glam::Vec2| surface_point(worker, frame, px);
+                let used = self.tools.cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
+                if s.overlays {
+                    let painter = ui.painter().with_clip_rect(rect);
+                    if let Some(o) = &self.outline {
+                        painter.image(o.id(), rect, uv, egui::Color32::WHITE);
+                    }
+                    overlays::triad(&painter, &view.basis, rect);
+                    overlays::lights(&painter, &view.basis, rect, &doc.scene);
+                    if let Some(g) = ViewTools::gizmo(doc, &view, s.gizmo_axes) {
+                        g.paint(&painter, &view, self.tools.hot);
+                    }
+                }
                 if let Some((mx, my)) = self.marker {
                     let c = rect.min
                         + egui::vec2(
@@ -360,6 +408,7 @@ impl Viewport {
                     ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
                 }
                 if resp.clicked()
+                    && !used
                     && let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p))
                 {
                     let u = (pos.x - rect.left()) / rect.width();
@@ -376,6 +425,30 @@ impl Viewport {
             }
         });
         pick
+    }
+
+    /// The outline of the selection, made again when the pixels or the selection change.
+    fn upload_outline(&mut self, ctx: &egui::Context, p: &Published, doc: &Document) {
+        // The image on screen stays the previous one until a pass is done; so does its outline.
+        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else { return };
+        // Once a pass, not once a tile: it runs over every pixel.
+        let key = Some((p.job.request, p.passes_done as u64, doc.selection, doc.generation));
+        if self.outline_key == key {
+            return;
+        }
+        self.outline_key = key;
+        let ids = match doc.selection {
+            Some(Selection::Node(id)) => overlays::subtree_ids(&doc.scene, id),
+            _ => Default::default(),
+        };
+        let image = overlays::outline(&frame.lock(), &ids);
+        self.outline = image.map(|img| match self.outline.take() {
+            Some(mut t) => {
+                t.set(img, egui::TextureOptions::NEAREST);
+                t
+            }
+            None => ctx.load_texture("selection-outline", img, egui::TextureOptions::NEAREST),
+        });
     }
 
     /// The images the last frame drew, in drawing order, with the pixels their textures
@@ -472,4 +545,23 @@ impl Viewport {
             normal_transform: s.normal_transform,
         }
     }
+}
+
+/// The world point the image on screen shows at pixel `px` of frame `frame`, from the render
+/// itself (its camera and the hit's t); `None` over the background.
+fn surface_point(worker: &RenderWorker, frame: usize, px: glam::Vec2) -> Option<glam::Vec3> {
+    worker.with_published(|p| {
+        let p = p?;
+        let f = p.frames.get(frame)?.lock();
+        if px.x < 0.0 || px.y < 0.0 {
+            return None;
+        }
+        let (x, row) = (px.x as u32, px.y as u32);
+        let t = f.get(x, row)?.t;
+        if !t.is_finite() {
+            return None;
+        }
+        let ray = p.compiled.camera.pixel_ray(x, row, f.width, f.height);
+        Some(ray.origin + ray.direction * t)
+    })
 }

@@ -1,0 +1,128 @@
+//! What the render view draws over the image besides the gizmo: the selected object's
+//! outline (from the per-pixel object ids that picking uses), a world-axes triad and the
+//! directional lights' directions.
+
+use glam::Vec3;
+use tracelab_core::{Frame, NodeId, Scene};
+
+use crate::gui::navigation::ViewBasis;
+
+const OUTLINE: [u8; 4] = [255, 150, 20, 255];
+
+/// The outline of the pixels showing the nodes marked in `nodes` (indexed by raw node id):
+/// each such pixel with a neighbour that shows something else, as an RGBA image the size of
+/// the frame (clear elsewhere). `None` when no pixel shows them.
+pub fn outline(frame: &Frame, nodes: &[bool]) -> Option<egui::ColorImage> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    if w == 0 || h == 0 || !nodes.contains(&true) {
+        return None;
+    }
+    // A table, not a set: this runs over every pixel on the UI thread.
+    let inside: Vec<bool> = frame.samples.iter().map(|s| nodes.get(s.node as usize).copied().unwrap_or(false)).collect();
+    let at = |x: usize, y: usize| inside.get(y * w + x).copied().unwrap_or(false);
+    let mut rgba = vec![0u8; w * h * 4];
+    let mut any = false;
+    for y in 0..h {
+        for x in 0..w {
+            if !at(x, y) {
+                continue;
+            }
+            let edge = x == 0 || y == 0 || x + 1 == w || y + 1 == h || !at(x - 1, y) || !at(x + 1, y) || !at(x, y - 1) || !at(x, y + 1);
+            if edge {
+                rgba[(y * w + x) * 4..][..4].copy_from_slice(&OUTLINE);
+                any = true;
+            }
+        }
+    }
+    any.then(|| egui::ColorImage::from_rgba_unmultiplied([w, h], &rgba))
+}
+
+/// `node` and everything under it, marked by raw id: what its pixels may name.
+pub fn subtree_ids(scene: &Scene, node: NodeId) -> Vec<bool> {
+    let mut mask = vec![false; scene.graph.capacity_len()];
+    for id in scene.graph.preorder_from(node) {
+        if let Some(m) = mask.get_mut(id.index()) {
+            *m = true;
+        }
+    }
+    mask
+}
+
+/// A world direction as a screen vector (points, y down), as seen by the camera.
+fn on_screen(basis: &ViewBasis, d: Vec3) -> egui::Vec2 {
+    egui::vec2(d.dot(basis.horizontal), -d.dot(basis.up))
+}
+
+/// The world axes in the image's lower-left corner.
+pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
+    let o = rect.left_bottom() + egui::vec2(34.0, -34.0);
+    painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
+    let axes = [
+        (Vec3::X, "x", egui::Color32::from_rgb(230, 70, 70)),
+        (Vec3::Y, "y", egui::Color32::from_rgb(90, 210, 90)),
+        (Vec3::Z, "z", egui::Color32::from_rgb(90, 140, 255)),
+    ];
+    // Farthest first, so the nearer axes draw over it.
+    let mut order: Vec<_> = axes.iter().collect();
+    order.sort_by(|a, b| b.0.dot(basis.direction).total_cmp(&a.0.dot(basis.direction)));
+    for (d, name, c) in order {
+        let v = on_screen(basis, *d) * 20.0;
+        painter.line_segment([o, o + v], egui::Stroke::new(2.0, *c));
+        painter.text(o + v * 1.2, egui::Align2::CENTER_CENTER, *name, egui::FontId::monospace(11.0), *c);
+    }
+}
+
+/// Each directional light's direction (from the light into the scene) in the image's upper
+/// right corner, in the light's colour.
+pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scene: &Scene) {
+    for (i, l) in scene.lights().iter().enumerate() {
+        let Some(d) = tracelab_core::scene::unit(l.direction) else { continue };
+        let c = l.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
+        let colour = egui::Color32::from_rgb(c.x as u8, c.y as u8, c.z as u8).gamma_multiply(0.5).to_opaque();
+        let colour = if colour.r().max(colour.g()).max(colour.b()) < 60 { egui::Color32::LIGHT_GRAY } else { colour };
+        let o = rect.right_top() + egui::vec2(-34.0 - 60.0 * i as f32, 34.0);
+        painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
+        let v = on_screen(basis, d) * 20.0;
+        // Into the screen: a cross; out of it: a dot (the light is behind the viewer).
+        if v.length() < 4.0 {
+            // Drawn, not typed: the UI's fonts have no ⊗ or ⊙.
+            let stroke = egui::Stroke::new(2.0, colour);
+            painter.circle_stroke(o, 7.0, stroke);
+            if d.dot(basis.direction) > 0.0 {
+                painter.line_segment([o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)], stroke);
+                painter.line_segment([o + egui::vec2(-5.0, 5.0), o + egui::vec2(5.0, -5.0)], stroke);
+            } else {
+                painter.circle_filled(o, 2.5, colour);
+            }
+        } else {
+            painter.arrow(o - v * 0.5, v, egui::Stroke::new(2.0, colour));
+        }
+        painter.text(o + egui::vec2(0.0, 18.0), egui::Align2::CENTER_TOP, format!("light {i}"), egui::FontId::proportional(10.0), colour);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tracelab_core::Sample;
+
+    #[test]
+    fn the_outline_is_the_border_of_the_selected_pixels() {
+        let mut f = Frame::new(5, 5);
+        for y in 1..4 {
+            for x in 1..4 {
+                f.samples[y * 5 + x] = Sample { node: 7, ..Sample::UNSET };
+            }
+        }
+        let mut seven = vec![false; 9];
+        seven[7] = true;
+        let img = outline(&f, &seven).expect("drawn");
+        let lit: Vec<usize> = img.pixels.iter().enumerate().filter(|(_, c)| c.a() > 0).map(|(i, _)| i).collect();
+        // The 3×3 block's ring of 8, not its centre.
+        assert_eq!(lit.len(), 8);
+        assert!(!lit.contains(&12));
+        let mut eight = vec![false; 9];
+        eight[8] = true;
+        assert!(outline(&f, &eight).is_none());
+    }
+}
