@@ -138,6 +138,20 @@ fn bench_progressive_reports_coarse_before_full() {
 }
 
 #[test]
+fn bench_progressive_times_single_rays_when_asked() {
+    let d = quad_scene("progressive-single");
+    for (flag, says) in [(None, "in packets of 8"), (Some("--single-rays"), "one at a time")] {
+        let mut args = vec!["bench-progressive", "quad.txt", "--size", "32", "32", "--repeat", "1"];
+        args.extend(flag);
+        let o = tracelab(&args, &d);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(out.contains(&format!("primary rays {says}")), "{out}");
+        assert!(out.lines().last().unwrap_or_default().starts_with("PROGRESSIVE "), "{out}");
+    }
+}
+
+#[test]
 fn bench_progressive_times_a_camera_orbit_per_step() {
     let d = quad_scene("orbit");
     let o = tracelab(&["bench-progressive", "quad.txt", "--size", "64", "64", "--repeat", "1", "--orbit", "6"], &d);

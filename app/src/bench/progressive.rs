@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use tracelab_core::render::SharedFrame;
 use glam::Vec3;
 use tracelab_core::render::render_coarse;
+use tracelab_core::render::{Tracing, render_progressive_traced};
 use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, render_progressive};
 
 use crate::gui::bounds::world_bounds;
@@ -30,12 +31,13 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     };
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
+    let tracing = if b.single_rays { Tracing::SingleRays } else { Tracing::Packets };
     let once = || {
         let start = Instant::now();
         let compiled = CompiledScene::new(&scene);
         let mut coarse = None;
         let mut full = Duration::ZERO;
-        let _ = render_progressive(&compiled, &settings, &target, &never, |_| {
+        let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |_| {
             coarse.get_or_insert(start.elapsed());
             full = start.elapsed();
         });
@@ -49,9 +51,10 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
     out!(
-        "frame: {w}x{h}, {} threads, medians of {}",
+        "frame: {w}x{h}, {} threads, medians of {}, primary rays {}",
         rayon::current_num_threads(),
-        runs.len()
+        runs.len(),
+        if b.single_rays { "one at a time" } else { "in packets of 8" }
     );
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
     if let Some(steps) = b.orbit {

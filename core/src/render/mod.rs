@@ -15,7 +15,10 @@ pub use compile::{CompiledScene, Hit, Object, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
-pub use progressive::{Cancelled, PassInfo, SharedFrame, render_coarse, render_frame, render_full, render_progressive};
+pub use progressive::{
+    Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced, render_full, render_progressive,
+    render_progressive_traced,
+};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 
 /// How world normals are obtained from object-space ones under a Transform.

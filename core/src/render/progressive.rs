@@ -76,12 +76,53 @@ pub struct PassInfo {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cancelled;
 
+/// How primary rays reach the scene. The two give the same image bit for bit (tested on every
+/// course and perf scene); `Packets` is what every render uses, `SingleRays` is there to
+/// prove that and to measure the difference.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Tracing {
+    /// Eight neighbouring pixels at a time (`CompiledScene::intersect8`: one packet for a
+    /// one-mesh scene, else one by one), shaded one by one.
+    #[default]
+    Packets,
+    SingleRays,
+}
+
 /// Traces one pixel's ray and shades it.
 #[inline]
 fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray) -> Sample {
-    match scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY) {
+    let hit = scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY);
+    shade_sample(scene, s, &ray, hit)
+}
+
+/// Appends the samples of `px` (one tile's pixels to trace, in the order `pixels_to_trace`
+/// gives them: 4×2 neighbourhoods), eight rays at a time.
+fn trace_packets(
+    scene: &CompiledScene,
+    s: &RenderSettings,
+    rays: &super::camera::PixelRays,
+    px: &[(u32, u32)],
+    out: &mut Vec<(u32, u32, Sample)>,
+) {
+    let t_min = scene.camera.t_min();
+    for chunk in px.chunks(8) {
+        let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
+        for (k, &(x, row)) in chunk.iter().enumerate() {
+            r[k] = rays.row(row).ray(x);
+        }
+        let active = ((1u16 << chunk.len()) - 1) as u8;
+        let hits = scene.intersect8(&r, active, t_min, f32::INFINITY);
+        for (k, &(x, row)) in chunk.iter().enumerate() {
+            out.push((x, row, shade_sample(scene, s, &r[k], hits[k])));
+        }
+    }
+}
+
+#[inline]
+fn shade_sample(scene: &CompiledScene, s: &RenderSettings, ray: &Ray, hit: Option<super::compile::Hit>) -> Sample {
+    match hit {
         Some(hit) => {
-            let (c, n) = shade_fast(scene, &ray, &hit, s);
+            let (c, n) = shade_fast(scene, ray, &hit, s);
             // The operand, for a CSG surface: what the pixel inspector and picking show.
             let node = scene.hit_node(&hit).map_or(u32::MAX, |n| n.0);
             sample_from(c, n, hit.t, node)
@@ -103,7 +144,7 @@ pub fn render_progressive(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES, Tracing::default(), &mut on_pass)
 }
 
 /// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
@@ -115,15 +156,33 @@ pub fn render_coarse(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES[..2], &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES[..2], Tracing::default(), &mut on_pass)
 }
 
 /// Renders the full-resolution image in one pass.
 pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
+    render_frame_traced(scene, settings, Tracing::default())
+}
+
+/// [`render_frame`] with the primary rays traced as `tracing` says.
+pub fn render_frame_traced(scene: &CompiledScene, settings: &RenderSettings, tracing: Tracing) -> Frame {
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
-    let _ = render_full(scene, settings, &target, &never);
+    let _ = render_scales(scene, settings, &target, &never, &[1], tracing, &mut |_| {});
     std::mem::replace(&mut *target.lock(), Frame::new(0, 0))
+}
+
+/// [`render_progressive`] with the primary rays traced as `tracing` says (for comparing the
+/// two in `bench-progressive`).
+pub fn render_progressive_traced(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    target: &SharedFrame,
+    cancel: &AtomicBool,
+    tracing: Tracing,
+    mut on_pass: impl FnMut(PassInfo),
+) -> Result<(), Cancelled> {
+    render_scales(scene, settings, target, cancel, &SCALES, tracing, &mut on_pass)
 }
 
 /// One full-resolution pass into `target` (which others may watch for progress).
@@ -133,7 +192,31 @@ pub fn render_full(
     target: &SharedFrame,
     cancel: &AtomicBool,
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &[1], &mut |_| {})
+    render_scales(scene, settings, target, cancel, &[1], Tracing::default(), &mut |_| {})
+}
+
+/// The pixels of a tile that a pass of `scale` traces, in 4×2 neighbourhoods of its grid (two
+/// rows, four columns at a time), so that eight consecutive ones make a coherent packet.
+fn pixels_to_trace(
+    (x0, y0, x1, y1): (u32, u32, u32, u32),
+    scale: u32,
+    traced_before: impl Fn(u32, u32) -> bool,
+) -> Vec<(u32, u32)> {
+    let mut px = Vec::new();
+    let step = scale as usize;
+    for row in (y0..y1).step_by(2 * step) {
+        for x in (x0..x1).step_by(4 * step) {
+            for r in [row, row + scale] {
+                for k in 0..4 {
+                    let xx = x + k * scale;
+                    if r < y1 && xx < x1 && !traced_before(xx, r) {
+                        px.push((xx, r));
+                    }
+                }
+            }
+        }
+    }
+    px
 }
 
 fn render_scales(
@@ -142,6 +225,7 @@ fn render_scales(
     target: &SharedFrame,
     cancel: &AtomicBool,
     scales: &[u32],
+    tracing: Tracing,
     on_pass: &mut dyn FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
     let start = Instant::now();
@@ -174,17 +258,21 @@ fn render_scales(
             let x1 = (x0 + TILE).min(w);
             let y1 = (y0 + TILE).min(h);
             let mut local: Vec<(u32, u32, Sample)> = Vec::new();
-            for row in (y0..y1).step_by(scale as usize) {
-                let row_rays = rays.row(row);
-                for x in (x0..x1).step_by(scale as usize) {
-                    // Already traced by a coarser pass.
-                    if let Some(c) = coarser
-                        && x % c == 0
-                        && row % c == 0
-                    {
-                        continue;
+            let traced_before = |x: u32, row: u32| coarser.is_some_and(|c| x % c == 0 && row % c == 0);
+            match tracing {
+                Tracing::SingleRays => {
+                    for row in (y0..y1).step_by(scale as usize) {
+                        let row_rays = rays.row(row);
+                        for x in (x0..x1).step_by(scale as usize) {
+                            if !traced_before(x, row) {
+                                local.push((x, row, trace_sample(scene, settings, row_rays.ray(x))));
+                            }
+                        }
                     }
-                    local.push((x, row, trace_sample(scene, settings, row_rays.ray(x))));
+                }
+                Tracing::Packets => {
+                    let px = pixels_to_trace((x0, y0, x1, y1), scale, traced_before);
+                    trace_packets(scene, settings, &rays, &px, &mut local);
                 }
             }
             let mut f = target.lock();

@@ -1,0 +1,82 @@
+//! The renderer's primary rays as packets (`Tracing::Packets`, what every render uses) give
+//! the image single rays give, bit for bit: colour, normal, t and object id of every pixel,
+//! in one full pass and through the progressive passes (whose coarse samples are sparse
+//! packets), on tracelab's scenes and on the course's and perf scenes in ../shared, under
+//! both normal rules and with and without shade_back.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
+use tracelab_core::{CompiledScene, Frame, MeshCache, NormalTransform, RenderSettings, SharedFrame, load_scene};
+
+fn same(a: &Frame, b: &Frame) -> Result<(), String> {
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err("sizes differ".into());
+    }
+    for (i, (x, y)) in a.samples.iter().zip(&b.samples).enumerate() {
+        if x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits() || x.node != y.node {
+            return Err(format!("pixel {} of row {} differs: {x:?} vs {y:?}", i as u32 % a.width, i as u32 / a.width));
+        }
+    }
+    Ok(())
+}
+
+fn check(path: &Path, (w, h): (u32, u32)) {
+    let scene = load_scene(path, &mut MeshCache::new())
+        .into_result()
+        .unwrap_or_else(|d| panic!("{}: {d}", path.display()))
+        .0;
+    let c = CompiledScene::new(&scene);
+    for normal_transform in [NormalTransform::Correct, NormalTransform::Incorrect] {
+        for shade_back in [false, true] {
+            let s = RenderSettings { shade_back, normal_transform, ..RenderSettings::new(w, h) };
+            let single = render_frame_traced(&c, &s, Tracing::SingleRays);
+            let packets = render_frame_traced(&c, &s, Tracing::Packets);
+            same(&single, &packets).unwrap_or_else(|e| panic!("{} {s:?}: one pass: {e}", path.display()));
+            let target = SharedFrame::new();
+            let never = std::sync::atomic::AtomicBool::new(false);
+            render_progressive_traced(&c, &s, &target, &never, Tracing::Packets, |_| {}).expect("not cancelled");
+            same(&single, &target.lock()).unwrap_or_else(|e| panic!("{} {s:?}: progressive: {e}", path.display()));
+        }
+    }
+}
+
+fn txt_files(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}: this test needs ../shared beside the checkout", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "txt"))
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with(prefix)))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn packets_match_single_rays_on_tracelab_s_scenes() {
+    let scenes = txt_files(&common::repo().join("scenes"), "");
+    assert!(scenes.len() >= 5, "{scenes:?}");
+    // Odd sizes: partial 4×2 neighbourhoods at the right and bottom edges and in coarse passes.
+    for s in &scenes {
+        check(s, (83, 61));
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+fn packets_match_single_rays_on_the_course_and_perf_scenes() {
+    let shared = common::repo().join("../shared");
+    let course = txt_files(&shared.join("mit6837/scenes"), "scene");
+    assert!(course.len() >= 20, "{course:?}");
+    for s in &course {
+        check(s, (101, 75));
+    }
+    // The perf scenes' meshes (bunny 69k, dragon 871k) at a size that keeps this quick.
+    let perf = txt_files(&shared.join("perf"), "bench_");
+    assert_eq!(perf.len(), 4, "{perf:?}");
+    for s in &perf {
+        check(s, (64, 48));
+    }
+}
