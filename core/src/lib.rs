@@ -11,7 +11,7 @@ pub mod scene;
 pub use format::{Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, parse_scene, rebase_mesh_paths, try_write_scene, write_scene};
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
 pub use render::{
-    CompiledScene, Frame, NormalTransform, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
+    CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
     render_progressive,
 };
 pub use scene::{

@@ -5,7 +5,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use tracelab_core::render::SharedFrame;
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, render_progressive};
+use tracelab_core::{CompiledScene, RenderSettings, render_progressive};
 
 use super::{ProgressiveArgs, median};
 use crate::exit::check_size;
@@ -17,12 +17,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let (w, h) = (b.size[0], b.size[1]);
     check_size(w, h)?;
     let scene = load_scene(Some(&b.scene))?;
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        shade_back: false,
-        normal_transform: NormalTransform::Correct,
-    };
+    let settings = RenderSettings::new(w, h);
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
     let once = || {

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::compile::CompiledScene;
 use super::frame::{Frame, Sample, sample_from};
 use super::shade::shade_fast;
-use super::RenderSettings;
+use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
 const TILE: u32 = 64;
@@ -79,7 +79,13 @@ pub struct Cancelled;
 /// Traces one pixel's ray and shades it.
 #[inline]
 fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray) -> Sample {
-    match scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY) {
+    // The default rule stays on the fast path, exactly as before the other rules existed.
+    let hit = if s.object_rays == ObjectRays::Unnormalized {
+        scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY)
+    } else {
+        scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
+    };
+    match hit {
         Some(hit) => {
             let (c, n) = shade_fast(scene, &ray, &hit, s);
             // The operand, for a CSG surface: what the pixel inspector and picking show.

@@ -3,7 +3,7 @@
 //! new pixels), and picking.
 
 use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size};
-use tracelab_core::{NormalTransform, RenderSettings, View};
+use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 
 use crate::render_worker::{Published, RenderWorker};
 
@@ -28,6 +28,8 @@ pub struct ViewSettings {
     pub tab: Tab,
     pub compare: Compare,
     pub normal_transform: NormalTransform,
+    /// How rays enter object space and which t is kept (the lecture's depth question).
+    pub object_rays: ObjectRays,
     pub shade_back: bool,
     pub depth: (f32, f32),
     /// `None`: follow the view's size in pixels.
@@ -42,6 +44,7 @@ impl Default for ViewSettings {
             tab: Tab::Color,
             compare: Compare::Off,
             normal_transform: NormalTransform::Correct,
+            object_rays: ObjectRays::Unnormalized,
             shade_back: false,
             depth: (8.0, 18.0),
             fixed_size: None,
@@ -469,6 +472,7 @@ impl Viewport {
             height: size.1.max(1),
             shade_back: s.shade_back,
             normal_transform: s.normal_transform,
+            object_rays: s.object_rays,
         }
     }
 }
