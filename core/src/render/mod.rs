@@ -9,7 +9,9 @@ mod inspect;
 mod limits;
 mod object_rays;
 mod progressive;
+mod rule_gap;
 mod shade;
+mod similitude;
 
 pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, Shape, Xf};
@@ -18,6 +20,8 @@ pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use object_rays::{ObjectRays, ObjectT};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
 pub use progressive::{Cancelled, PassInfo, SharedFrame, render_frame, render_full, render_progressive};
+pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
+pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 
 /// How world normals are obtained from object-space ones under a Transform.
