@@ -10,6 +10,7 @@ pub mod exit;
 pub mod gui;
 pub mod io;
 pub mod render_worker;
+pub mod story;
 
 /// The scene tracelab opens when started with no file.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.txt");

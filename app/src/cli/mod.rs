@@ -6,6 +6,7 @@
 
 mod course;
 mod fmt;
+mod inspect;
 mod render;
 mod values;
 
@@ -46,6 +47,9 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
     Render(RenderArgs),
+    /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).
+    #[command(long_about = inspect::LONG_ABOUT)]
+    Inspect(inspect::InspectArgs),
     /// Rewrite a scene file in canonical form.
     Fmt {
         scene: PathBuf,
@@ -109,6 +113,7 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
     };
     match cli.command {
         Some(Command::Render(r)) => run_render(&render::render_job(r)?),
+        Some(Command::Inspect(a)) => inspect::run_inspect(&a),
         Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
         Some(Command::BenchProgressive(b)) => {
