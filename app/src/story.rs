@@ -393,3 +393,19 @@ pub fn report_text(r: &PixelReport) -> String {
     out.push(format!("  sum                    {} -> bytes {:?}", v3(r.color), r.rgb8));
     out.join("\n") + "\n"
 }
+
+/// One line for a pixel: what the ray hit, at which t, with which normal (for `tracelab diff`).
+pub fn one_line(r: &PixelReport) -> String {
+    let Some(h) = &r.hit else {
+        return format!("the ray misses everything: background {}", v3(r.background));
+    };
+    let kept = if h.t.used_is == "object" { format!(" (kept the object-space t {:.4})", h.t.used) } else { String::new() };
+    let n = if h.shading.normal_rule == "correct" { h.normal.world_correct } else { h.normal.world_incorrect };
+    let rule = if h.shading.normal_rule == "correct" { "(M⁻¹)ᵀ" } else { "M" };
+    let other = if h.normal.angle_degrees > 0.01 {
+        format!(", {:.2}° from the other rule's", h.normal.angle_degrees)
+    } else {
+        String::new()
+    };
+    format!("{} at t = {:.4}{kept}, normal by {rule} {}{other}", h.node.label, h.t.world, v3(n))
+}

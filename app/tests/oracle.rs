@@ -196,3 +196,139 @@ fn inspect_text_names_rows_from_the_top_and_refuses_pixels_outside() {
     let o = tracelab(&["inspect", scene, "--size", "0", "4", "--pixel", "0", "0"], &repo());
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Renders the course line with tracelab into `dir` (the "student's" outputs), then runs
+/// `tracelab diff IMAGE -- LINE`.
+fn course_line(scene: &Path) -> Vec<String> {
+    let s = scene.to_str().expect("utf-8").to_string();
+    ["-input", &s, "-size", "50", "40", "-output", "out.png", "-normals", "n.png", "-depth", "8", "11", "d.png"]
+        .map(String::from)
+        .to_vec()
+}
+
+fn diff(dir: &Path, image: &str, line: &[String], extra: &[&str]) -> Output {
+    let mut args = vec!["diff", image];
+    args.extend_from_slice(extra);
+    args.push("--");
+    args.extend(line.iter().map(String::as_str));
+    tracelab(&args, dir)
+}
+
+#[test]
+fn diff_of_a_perfect_image_matches_and_leaves_the_students_files_alone() {
+    let dir = temp_dir("diff-perfect");
+    let line = course_line(&repo().join("scenes/sheared_sphere.txt"));
+    let args: Vec<&str> = line.iter().map(String::as_str).collect();
+    assert!(tracelab(&args, &dir).status.success());
+    std::fs::copy(dir.join("out.png"), dir.join("mine.png")).expect("copy");
+    let before: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"].iter().map(|f| std::fs::read(dir.join(f)).expect("read")).collect();
+    let o = diff(&dir, "mine.png", &line, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}{}", stderr(&o));
+    for want in ["colour mine.png: 100.00% of 2000 pixels", "normals n.png: 100.00%", "depth d.png: 100.00%", "matches"] {
+        assert!(out.contains(want), "{want} missing:\n{out}");
+    }
+    let after: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"].iter().map(|f| std::fs::read(dir.join(f)).expect("read")).collect();
+    assert_eq!(before, after, "diff must not write the files the line names");
+    // The heat map of a perfect image is the reference, dimmed to a quarter, in grey.
+    let map = image::open(dir.join("mine.diff.png")).expect("heat map").to_rgb8();
+    let reference = image::open(dir.join("out.png")).expect("ref").to_rgb8();
+    for (m, r) in map.pixels().zip(reference.pixels()) {
+        let lum = (u32::from(r[0]) * 3 + u32::from(r[1]) * 6 + u32::from(r[2])) / 10;
+        assert_eq!(m.0, [(lum / 4) as u8; 3]);
+    }
+}
+
+#[test]
+fn diff_of_a_slightly_wrong_image_names_the_wrong_pixels_and_still_matches() {
+    let dir = temp_dir("diff-slight");
+    let line = course_line(&repo().join("scenes/sheared_sphere.txt"));
+    let args: Vec<&str> = line.iter().map(String::as_str).collect();
+    assert!(tracelab(&args, &dir).status.success());
+    // Six pixels off by 30 in red, one by 90: 7 of 2000 is 0.35%, under the 1% allowed.
+    let mut img = image::open(dir.join("out.png")).expect("out").to_rgb8();
+    let spots = [(10u32, 5u32, 30u8), (11, 5, 30), (12, 5, 30), (30, 20, 30), (31, 20, 30), (32, 20, 30), (36, 21, 90)];
+    for &(x, row, by) in &spots {
+        let p = img.get_pixel_mut(x, row);
+        p[0] = if p[0] >= by { p[0] - by } else { p[0] + by };
+    }
+    img.save(dir.join("mine.png")).expect("save");
+    let o = diff(&dir, "mine.png", &line, &["--worst", "3"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("99.65% of 2000 pixels within 8/255 (largest difference 90)"), "{out}");
+    // The worst first, then ties by row and column.
+    let listed: Vec<&str> = out.lines().filter(|l| l.starts_with("  (")).collect();
+    assert_eq!(listed.len(), 3, "{out}");
+    assert!(listed[0].starts_with("  (36, 21):") && listed[0].contains("off by 90"), "{out}");
+    assert!(listed[1].starts_with("  (10, 5):") && listed[2].starts_with("  (11, 5):"), "{out}");
+    // (36, 21) is on the red sheared sphere, centred at world x = 1.2 = (36.5/50 − ½)·5: its story says so, with t and the normal rule.
+    assert!(listed[0].contains("Sphere") && listed[0].contains("t = ") && listed[0].contains("normal by (M⁻¹)ᵀ"), "{}", listed[0]);
+    let map = image::open(dir.join("mine.diff.png")).expect("heat map").to_rgb8();
+    for (x, row, p) in map.enumerate_pixels() {
+        let marked = spots.iter().any(|s| (s.0, s.1) == (x, row));
+        assert_eq!(p[0] == 255 && p[2] == 0 && p[1] >= 9, marked, "({x}, {row}) {:?}", p.0);
+    }
+    // A stricter grader fails it.
+    assert_eq!(diff(&dir, "mine.png", &line, &["--min-match", "99.9"]).status.code(), Some(3));
+}
+
+#[test]
+fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
+    let dir = temp_dir("diff-wrong");
+    let scene = repo().join("scenes/sheared_sphere.txt");
+    let line = course_line(&scene);
+    let args: Vec<&str> = line.iter().map(String::as_str).collect();
+    assert!(tracelab(&args, &dir).status.success());
+    // The incorrect normal rule: the classic wrong image.
+    let s = scene.to_str().expect("utf-8");
+    let o = tracelab(&["-input", s, "-size", "50", "40", "-output", "wrong.png", "-normal_transform", "incorrect"], &dir);
+    assert!(o.status.success());
+    let o = diff(&dir, "wrong.png", &line, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}");
+    assert!(out.contains("colour wrong.png:") && out.contains("does not match"), "{out}");
+    assert!(out.contains("from the other rule's"), "the worst pixels are where the rules part:\n{out}");
+    // Wrong size: said with both sizes, before any pixel.
+    let o = tracelab(&["-input", s, "-size", "40", "40", "-output", "small.png"], &dir);
+    assert!(o.status.success());
+    let o = diff(&dir, "small.png", &line, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}");
+    assert!(out.contains("size 40×40, but the command line asks for 50×40: does not match"), "{out}");
+    // A missing image is an error (1), a bad line a usage error (2).
+    assert_eq!(diff(&dir, "absent.png", &line, &[]).status.code(), Some(1));
+    let o = tracelab(&["diff", "small.png", "--", "-input", s, "-size", "50"], &dir);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+#[ignore = "needs ../shared/mit6837"]
+fn diff_accepts_the_courses_own_reference_images() {
+    let shared = repo().join("../shared/mit6837");
+    assert!(shared.join("scenes").is_dir(), "{} is missing: this test needs ../shared beside the checkout", shared.display());
+    let dir = temp_dir("diff-course");
+    for f in ["scene2_11_squashed_sphere.txt", "scene2_16_t_scale.txt"] {
+        std::fs::copy(shared.join("scenes").join(f), dir.join(f)).expect("copy scene");
+    }
+    for (img, line) in [
+        ("output2_11.png", "-input scene2_11_squashed_sphere.txt -size 200 200 -output x.png"),
+        ("output2_16.png", "-input scene2_16_t_scale.txt -size 200 200 -output x.png"),
+    ] {
+        std::fs::copy(shared.join("reference").join(img), dir.join(img)).expect("copy reference");
+        let line: Vec<String> = line.split(' ').map(String::from).collect();
+        let o = diff(&dir, img, &line, &[]);
+        assert_eq!(o.status.code(), Some(0), "{img}: {}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    }
+    // The depth image of scene2_16 as the bug draws it fails against the reference.
+    std::fs::copy(shared.join("reference/depth2_16.png"), dir.join("depth2_16.png")).expect("copy");
+    let line = "-input scene2_16_t_scale.txt -size 200 200 -output bug.png -depth 2 7 bug_depth.png -object_rays normalized-no-rescale";
+    let args: Vec<&str> = line.split(' ').collect();
+    assert!(tracelab(&args, &dir).status.success());
+    let good: Vec<String> = "-input scene2_16_t_scale.txt -size 200 200 -output x.png -depth 2 7 bug_depth.png".split(' ').map(String::from).collect();
+    let o = diff(&dir, "output2_16.png", &good, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}");
+    assert!(out.contains("colour output2_16.png: 100.00%") || out.contains("colour output2_16.png: 99."), "{out}");
+    assert!(out.contains("depth bug_depth.png:") && out.contains("does not match"), "{out}");
+}

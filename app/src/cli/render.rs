@@ -163,7 +163,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
 }
 
 /// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
-fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
+pub(super) fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
     let target = Arc::new(SharedFrame::new());
     let done = Arc::new(AtomicBool::new(false));
     let watcher = std::io::stderr().is_terminal().then(|| {
