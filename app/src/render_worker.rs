@@ -8,8 +8,8 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::render_progressive;
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
+use tracelab_core::render::{NormalGap, normal_rule_gap, render_progressive};
+use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame};
 
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
 #[derive(Clone, Debug)]
@@ -36,6 +36,9 @@ pub struct Published {
     pub passes: usize,
     pub first_image: Option<Duration>,
     pub full: Option<Duration>,
+    /// The largest angle between the two normal rules over this render's pixels, computed
+    /// after the full image (so it never delays it).
+    pub normal_gap: Option<NormalGap>,
 }
 
 #[derive(Default)]
@@ -51,7 +54,7 @@ pub struct RenderWorker {
     thread: Option<std::thread::JoinHandle<()>>,
     last_generation: u64,
     requests: u64,
-    last_key: Option<(u32, u32, bool, Vec<NormalTransform>)>,
+    last_key: Option<(u32, u32, bool, ObjectRays, Vec<NormalTransform>)>,
 }
 
 impl Default for RenderWorker {
@@ -102,6 +105,7 @@ impl RenderWorker {
             settings.width,
             settings.height,
             settings.shade_back,
+            settings.object_rays,
             modes.clone(),
         );
         if generation == self.last_generation && self.last_key.as_ref() == Some(&key) {
@@ -195,6 +199,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 passes: 0,
                 first_image: None,
                 full: None,
+                normal_gap: None,
             };
             *p = Some(new);
         }
@@ -248,6 +253,19 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
         } else {
             (0..frames.len()).all(render_one)
         };
+        let repaint = || {
+            if let Some(f) = shared.repaint.lock().unwrap_or_else(PoisonError::into_inner).as_ref() {
+                f();
+            }
+        };
+        if ok && let Ok(gap) = normal_rule_gap(&compiled, &job.settings, &cancel) {
+            if let Some(p) = shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_mut() {
+                if p.job.request == job.request {
+                    p.normal_gap = Some(gap);
+                }
+            }
+            repaint();
+        }
         if ok && log {
             shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_ref().inspect(|p| {
                 eprintln!(

@@ -239,7 +239,8 @@ fn node(scene: &Scene, id: tracelab_core::NodeId) -> NodeReport {
     }
 }
 
-fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> HitReport {
+/// The hit part of the report (what the editor's panels draw).
+pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> HitReport {
     let mut world_from_object = DMat4::IDENTITY;
     let path = h
         .path
@@ -408,4 +409,23 @@ pub fn one_line(r: &PixelReport) -> String {
         String::new()
     };
     format!("{} at t = {:.4}{kept}, normal by {rule} {}{other}", h.node.label, h.t.world, v3(n))
+}
+
+/// For a node of the scene: its own similitude test when it is a Transform, and that of the
+/// world-from-object chain down to it (every Transform above it, and itself), in f64.
+pub fn node_similitudes(scene: &Scene, id: tracelab_core::NodeId) -> (Option<SimilitudeTest>, SimilitudeTest) {
+    use tracelab_core::NodeKind;
+    use tracelab_core::scene::validate::compose_f64;
+    let g = &scene.graph;
+    let mut chain = DMat4::IDENTITY;
+    for p in g.path_to(id).unwrap_or_default() {
+        if let Some(NodeKind::Transform(ops)) = g.get(p).map(|n| &n.kind) {
+            chain *= compose_f64(ops);
+        }
+    }
+    let own = match g.get(id).map(|n| &n.kind) {
+        Some(NodeKind::Transform(ops)) => Some(similitude(DMat3::from_mat4(compose_f64(ops)))),
+        _ => None,
+    };
+    (own, similitude(DMat3::from_mat4(chain)))
 }

@@ -890,7 +890,8 @@ impl TracelabApp {
         let mut pick = None;
         let mut size = (1, 1);
         egui::CentralPanel::default().show(ui, |ui| {
-            Viewport::toolbar(ui, &mut self.view);
+            let gap = self.worker.with_published(|p| p.and_then(|p| p.normal_gap));
+            Viewport::toolbar(ui, &mut self.view, gap);
             ui.separator();
             size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
             self.request_render(size);

@@ -1,6 +1,8 @@
 //! The largest angle between the two normal rules, (M⁻¹)ᵀ·n and M·n, over an image's
 //! pixels: the one number that says whether the incorrect rule shows anywhere on screen.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::Mat3;
 use rayon::prelude::*;
 
@@ -8,6 +10,7 @@ use super::RenderSettings;
 use super::compile::{CompiledScene, Hit, Object, Shape, Xf};
 use super::similitude::similitude_within;
 use super::NormalTransform;
+use super::progressive::Cancelled;
 
 /// f32 matrices carry about seven digits: closer than this to a similitude is one.
 const F32_TOLERANCE: f64 = 1e-6;
@@ -23,13 +26,18 @@ pub struct NormalGap {
 /// Traces every pixel of a `settings`-sized image (with its depth rule) and returns the
 /// largest angle between the two world normals. For a hit under a similitude the angle is 0
 /// by the theorem, (M⁻¹)ᵀ = λM, rather than the rounding of two f32 products.
-pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings) -> NormalGap {
+///
+/// Stops within a row once `cancel` is set (the editor computes it after each render).
+pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings, cancel: &AtomicBool) -> Result<NormalGap, Cancelled> {
     let (w, h) = (settings.width, settings.height);
     let rays = scene.camera.pixel_rays(w, h);
     let similar: Vec<bool> = scene.objects.iter().map(|o| object_is_similitude(o)).collect();
     (0..h)
         .into_par_iter()
         .map(|row| {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(Cancelled);
+            }
             let row_rays = rays.row(row);
             let mut best = NormalGap::default();
             for x in 0..w {
@@ -49,9 +57,9 @@ pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings) -> Norm
                     best = NormalGap { degrees: deg, pixel: Some((x, row)) };
                 }
             }
-            best
+            Ok(best)
         })
-        .reduce(NormalGap::default, |a, b| if b.degrees > a.degrees { b } else { a })
+        .try_reduce(NormalGap::default, |a, b| Ok(if b.degrees > a.degrees { b } else { a }))
 }
 
 fn xf_is_similitude(xf: Option<&Xf>) -> bool {
@@ -104,7 +112,7 @@ Group {{ numObjects 2 MaterialIndex 0
     fn only_similitudes_on_screen_give_exactly_zero() {
         let s = scene("ZRotate 20 UniformScale 1.3 XRotate 70 Scale -1 1 1");
         let c = CompiledScene::new(&s);
-        let gap = normal_rule_gap(&c, &RenderSettings::new(32, 32));
+        let gap = normal_rule_gap(&c, &RenderSettings::new(32, 32), &AtomicBool::new(false)).expect("not cancelled");
         assert_eq!(gap, NormalGap { degrees: 0.0, pixel: None });
     }
 
@@ -113,7 +121,8 @@ Group {{ numObjects 2 MaterialIndex 0
         let s = scene("ZRotate 20 Scale 1.5 0.5 1");
         let c = CompiledScene::new(&s);
         let settings = RenderSettings::new(32, 32);
-        let gap = normal_rule_gap(&c, &settings);
+        let gap = normal_rule_gap(&c, &settings, &AtomicBool::new(false)).expect("not cancelled");
+        assert_eq!(normal_rule_gap(&c, &settings, &AtomicBool::new(true)), Err(Cancelled));
         // Independently: the pixel inspector's angle at every pixel.
         let mut best = 0.0f32;
         for row in 0..32 {

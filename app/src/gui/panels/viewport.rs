@@ -2,7 +2,7 @@
 //! range and size controls, the images themselves (uploaded as textures when the worker has
 //! new pixels), and picking.
 
-use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size};
+use tracelab_core::render::{MAX_IMAGE_SIDE, NormalGap, check_image_size};
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 
 use crate::render_worker::{Published, RenderWorker};
@@ -50,6 +50,15 @@ impl Default for ViewSettings {
             fixed_size: None,
             split: 0.5,
         }
+    }
+}
+
+/// The depth-t rules as the toolbar names them.
+pub fn object_rays_label(r: ObjectRays) -> &'static str {
+    match r {
+        ObjectRays::Unnormalized => "unnormalised: t_OS = t_WS",
+        ObjectRays::Normalized => "normalised, t rescaled",
+        ObjectRays::NormalizedNoRescale => "normalised, t not rescaled (bug)",
     }
 }
 
@@ -153,8 +162,9 @@ pub struct Viewport {
 }
 
 impl Viewport {
-    /// The toolbar; returns true when a setting changed.
-    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings) {
+    /// The toolbar. `gap` is the largest angle between the two normal rules over the
+    /// pixels of the image on screen, once computed.
+    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings, gap: Option<NormalGap>) {
         ui.horizontal_wrapped(|ui| {
             for (tab, name) in [
                 (Tab::Color, "Colour"),
@@ -179,6 +189,12 @@ impl Viewport {
                     "Incorrect M",
                 );
             });
+            match gap {
+                Some(g) if g.degrees == 0.0 => ui.label("0° apart on screen: every transform hit is a similitude"),
+                Some(g) => ui.label(format!("up to {:.2}° apart on screen", g.degrees)),
+                None => ui.label("…"),
+            }
+            .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels");
             ui.separator();
             egui::ComboBox::from_label("compare")
                 .selected_text(match s.compare {
@@ -193,6 +209,15 @@ impl Viewport {
                 });
         });
         ui.horizontal_wrapped(|ui| {
+            // The lecture's "what to do about the depth t", for both images when comparing.
+            egui::ComboBox::from_label("depth t")
+                .selected_text(object_rays_label(s.object_rays))
+                .show_ui(ui, |ui| {
+                    for r in ObjectRays::ALL {
+                        ui.selectable_value(&mut s.object_rays, r, object_rays_label(r));
+                    }
+                });
+            ui.separator();
             ui.checkbox(&mut s.shade_back, "shade back");
             ui.separator();
             ui.label("depth");
