@@ -23,7 +23,8 @@ use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
 use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
-use crate::gui::panels::{inspector, pixel_inspector, status, tree};
+use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree};
+use crate::gui::ray_diagram::Orbit;
 
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -61,6 +62,10 @@ pub struct TracelabApp {
     /// Which pixel that is and the render it was traced in: every new render traces it again.
     pub inspected: Option<Inspected>,
     pub pixel_inspector_open: bool,
+    /// The Ray panel (world and object space diagrams) in the dock, beside the story.
+    pub ray_panel_open: bool,
+    /// How each Ray diagram (world, object) is turned.
+    pub ray_orbits: [Orbit; 2],
     pub dialog: Option<FileDialog>,
     native: Option<NativeDialog>,
     native_dialogs: bool,
@@ -103,6 +108,8 @@ impl TracelabApp {
             story: None,
             inspected: None,
             pixel_inspector_open: false,
+            ray_panel_open: true,
+            ray_orbits: [Orbit::default(); 2],
             dialog: None,
             native: None,
             native_dialogs: opts.native_dialogs,
@@ -233,6 +240,7 @@ impl TracelabApp {
                 self.doc.redo();
             }
             AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
+            AppCommand::ShowRayPanel(open) => self.ray_panel_open = open,
             AppCommand::ResetLayout => self.layout.reset(),
         }
     }
@@ -562,6 +570,10 @@ impl TracelabApp {
                 if ui.checkbox(&mut open, "Pixel inspector").changed() {
                     out.push(AppCommand::ShowPixelInspector(open));
                 }
+                let mut ray = self.ray_panel_open;
+                if ui.checkbox(&mut ray, "Ray panel (in the pixel inspector)").changed() {
+                    out.push(AppCommand::ShowRayPanel(ray));
+                }
                 if menu::button(ui, true, AppCommand::ResetLayout, &mut out)
                     .on_hover_text("Panels back to their first sizes")
                     .clicked()
@@ -875,10 +887,26 @@ impl TracelabApp {
             self.layout.dock_panel(height).show(ui, |ui| {
                 ui.horizontal(|ui| {
                     ui.strong("Pixel inspector");
+                    let mut ray = self.ray_panel_open;
+                    if ui.checkbox(&mut ray, "Ray diagrams").changed() {
+                        asked.push(AppCommand::ShowRayPanel(ray));
+                    }
                     if ui.small_button("Close").clicked() {
                         asked.push(AppCommand::ShowPixelInspector(false));
                     }
                 });
+                if self.ray_panel_open {
+                    // The lecture's figure, docked beside the story: never over the image.
+                    let width = ui.available_width();
+                    egui::Panel::right(self.layout.panel_id("ray"))
+                        .resizable(true)
+                        .default_size((width * 0.55).max(200.0))
+                        .max_size((width - 200.0).max(200.0))
+                        .show(ui, |ui| {
+                            let story = self.story.as_ref().map(|(s, sc)| (s, sc.as_ref()));
+                            ray_panel::ui(ui, story, &mut self.ray_orbits);
+                        });
+                }
                 egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| match &self.story {
                     Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
                     None => {

@@ -38,6 +38,8 @@ pub enum AppCommand {
     Undo,
     Redo,
     ShowPixelInspector(bool),
+    /// The Ray panel's diagrams beside the pixel inspector's story.
+    ShowRayPanel(bool),
     ResetLayout,
 }
 

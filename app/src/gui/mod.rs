@@ -10,6 +10,7 @@ pub mod loading;
 pub mod menu;
 pub mod native_dialog;
 pub mod panels;
+pub mod ray_diagram;
 pub mod settings;
 pub mod widgets;
 

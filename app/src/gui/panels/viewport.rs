@@ -190,11 +190,11 @@ impl Viewport {
                 );
             });
             match gap {
-                Some(g) if g.degrees == 0.0 => ui.label("0° apart on screen: every transform hit is a similitude"),
-                Some(g) => ui.label(format!("up to {:.2}° apart on screen", g.degrees)),
+                Some(g) if g.degrees == 0.0 => ui.label("0° apart: all similitudes"),
+                Some(g) => ui.label(format!("up to {:.2}° apart", g.degrees)),
                 None => ui.label("…"),
             }
-            .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels");
+            .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels (0 exactly when every transform on screen is a similitude)");
             ui.separator();
             egui::ComboBox::from_label("compare")
                 .selected_text(match s.compare {
