@@ -4,6 +4,7 @@
 //!
 //! Exit codes: 0 success, 1 scene or I/O error, 2 usage error (see `crate::exit`).
 
+mod animate;
 mod course;
 mod diff;
 mod fmt;
@@ -49,6 +50,8 @@ pub enum Command {
     /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
     Render(RenderArgs),
     /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).
+    /// Sweep one number of a Transform op over N frames: a PNG sequence and an animated PNG.
+    Animate(animate::AnimateArgs),
     /// Compare your image with the reference for a course command line (after --): heat map, worst pixels.
     #[command(long_about = diff::LONG_ABOUT)]
     Diff(diff::DiffArgs),
@@ -121,6 +124,7 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
         Some(Command::Render(r)) => run_render(&render::render_job(r)?),
         Some(Command::Inspect(a)) => inspect::run_inspect(&a),
         Some(Command::Diff(a)) => diff::run_diff(&a),
+        Some(Command::Animate(a)) => animate::run_animate(&a),
         Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
         Some(Command::BenchProgressive(b)) => {

@@ -8,6 +8,7 @@ use tracelab_core::NodeId;
 
 use crate::document::Selection;
 use crate::document::edit::Edit;
+use crate::gui::animation_dialog::AnimationForm;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum AppCommand {
@@ -25,6 +26,15 @@ pub enum AppCommand {
     /// Ask for a file to open.
     OpenDialog,
     Open(PathBuf),
+    /// Open a figure of the Lecture menu (index into `lecture::FIGURES`) and set its view.
+    OpenLecture(usize),
+    /// Hide the lecture figure's caption.
+    CloseCaption,
+    /// Open File › Export animation for the selected Transform.
+    AnimationDialog,
+    StartAnimation(AnimationForm),
+    CancelAnimation,
+    CloseAnimationDialog,
     Save,
     /// Ask where to save.
     SaveAsDialog,

@@ -1,11 +1,13 @@
 //! The desktop editor (eframe): the app that wires the document, the panels and the render
 //! worker together.
 
+pub mod animation_dialog;
 pub mod app;
 pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
 pub mod layout;
+pub mod lecture;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
