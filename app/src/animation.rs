@@ -91,6 +91,29 @@ pub fn frame_image(scene: &Scene, settings: &RenderSettings, compare: bool) -> R
     out
 }
 
+/// The editor's export form: a sweep, the compare switch and the folder.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnimationForm {
+    pub node: NodeId,
+    pub op: usize,
+    pub component: usize,
+    pub from: f32,
+    pub to: f32,
+    pub frames: u32,
+    pub compare: bool,
+    pub folder: String,
+}
+
+impl AnimationForm {
+    pub fn new(node: NodeId) -> Self {
+        AnimationForm { node, op: 0, component: 0, from: 0.0, to: 1.0, frames: 24, compare: false, folder: "animation".into() }
+    }
+
+    pub fn sweep(&self) -> Sweep {
+        Sweep { node: self.node, op: self.op, component: self.component, from: self.from, to: self.to, frames: self.frames }
+    }
+}
+
 #[derive(Debug, PartialEq)]
 pub enum AnimateError {
     Cancelled,

@@ -7,33 +7,11 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
-use tracelab_core::{NodeId, NodeKind, RenderSettings, Scene};
+use tracelab_core::{NodeKind, RenderSettings, Scene};
 
-use crate::animation::{AnimateError, Sweep, components, render_frames, write_frames};
+pub use crate::animation::AnimationForm;
+use crate::animation::{AnimateError, components, render_frames, write_frames};
 use crate::gui::command::AppCommand;
-
-/// The form's values.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AnimationForm {
-    pub node: NodeId,
-    pub op: usize,
-    pub component: usize,
-    pub from: f32,
-    pub to: f32,
-    pub frames: u32,
-    pub compare: bool,
-    pub folder: String,
-}
-
-impl AnimationForm {
-    pub fn new(node: NodeId) -> Self {
-        AnimationForm { node, op: 0, component: 0, from: 0.0, to: 1.0, frames: 24, compare: false, folder: "animation".into() }
-    }
-
-    pub fn sweep(&self) -> Sweep {
-        Sweep { node: self.node, op: self.op, component: self.component, from: self.from, to: self.to, frames: self.frames }
-    }
-}
 
 /// An export under way.
 pub struct Running {

@@ -8,7 +8,7 @@ use tracelab_core::NodeId;
 
 use crate::document::Selection;
 use crate::document::edit::Edit;
-use crate::gui::animation_dialog::AnimationForm;
+use crate::animation::AnimationForm;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum AppCommand {
