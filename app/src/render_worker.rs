@@ -144,7 +144,8 @@ impl RenderWorker {
     /// Whether the newest request has been fully rendered.
     pub fn is_idle(&self) -> bool {
         self.with_published(|p| {
-            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some())
+            // The normal-rule gap is part of what is shown (the toolbar), so idle waits for it.
+            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some() && p.normal_gap.is_some())
         })
     }
 

@@ -967,7 +967,7 @@ impl TracelabApp {
                     let width = ui.available_width();
                     egui::Panel::right(self.layout.panel_id("ray"))
                         .resizable(true)
-                        .default_size((width * 0.55).max(200.0))
+                        .default_size((width * 0.5).max(200.0))
                         .max_size((width - 200.0).max(200.0))
                         .show(ui, |ui| {
                             let story = self.story.as_ref().map(|(s, sc)| (s, sc.as_ref()));

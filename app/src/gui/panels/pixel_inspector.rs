@@ -93,18 +93,17 @@ pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
     ui.strong(format!("Hit {} at t = {:.5}", h.node.label, h.t.world));
     ui.label(t_line(&h, story_hit.object_rays));
     ui.label("Path, with the ray in each space (direction not renormalised: t is the same in every one):");
-    egui::Grid::new("path").striped(true).show(ui, |ui| {
-        for step in &h.path {
-            ui.label(&step.node.label);
-            ui.vertical(|ui| {
-                ui.label(format!("origin {}  direction {}", a(step.ray.origin), a(step.ray.direction)));
-                if let Some(t) = &step.transform {
-                    matrices_ui(ui, t);
-                }
-            });
-            ui.end_row();
-        }
-    });
+    // One block per node, label then ray then matrices: a two-column grid squeezed the ray
+    // into one number a line beside the Ray panel.
+    for step in &h.path {
+        ui.label(egui::RichText::new(&step.node.label).strong());
+        ui.indent(("step", step.node.id), |ui| {
+            ui.label(format!("origin {}  direction {}", a(step.ray.origin), a(step.ray.direction)));
+            if let Some(t) = &step.transform {
+                matrices_ui(ui, t);
+            }
+        });
+    }
     ui.label(format!("World from object: {}", ascii_math(&h.world_from_object.similitude.summary)));
     ui.separator();
     egui::Grid::new("hit").show(ui, |ui| {
