@@ -16,6 +16,10 @@ pub enum Exit {
     /// quietly with success, as a program killed by SIGPIPE would in a shell pipeline.
     #[error("standard output closed")]
     OutputClosed,
+    /// `tracelab diff`: the images were compared and do not match (exit 3; the comparison
+    /// itself was printed).
+    #[error("the images do not match")]
+    Differs,
 }
 
 /// The size limit of `tracelab_core::render::check_image_size`, as a usage error.

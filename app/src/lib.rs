@@ -3,6 +3,7 @@
 //! Layers, each using only those below it: `cli` (dispatch) → `bench`, `gui` → `document`,
 //! `render_worker`, `io`, `exit`. Nothing imports `cli`.
 
+pub mod animation;
 pub mod bench;
 pub mod cli;
 pub mod document;
@@ -11,6 +12,7 @@ pub mod gui;
 pub mod io;
 pub mod logging;
 pub mod render_worker;
+pub mod story;
 #[cfg(test)]
 mod test_support;
 

@@ -8,8 +8,8 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::{render_coarse, render_progressive};
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
+use tracelab_core::render::{NormalGap, normal_rule_gap, render_coarse, render_progressive};
+use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame};
 
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
 #[derive(Clone, Debug)]
@@ -38,6 +38,9 @@ pub struct Published {
     pub passes: usize,
     pub first_image: Option<Duration>,
     pub full: Option<Duration>,
+    /// The largest angle between the two normal rules over this render's pixels, computed
+    /// after the full image (so it never delays it).
+    pub normal_gap: Option<NormalGap>,
 }
 
 #[derive(Default)]
@@ -53,7 +56,7 @@ pub struct RenderWorker {
     thread: Option<std::thread::JoinHandle<()>>,
     last_generation: u64,
     requests: u64,
-    last_key: Option<(u32, u32, bool, Vec<NormalTransform>, bool)>,
+    last_key: Option<(u32, u32, bool, ObjectRays, Vec<NormalTransform>, bool)>,
     /// Render only the coarse passes from now on (the view is being dragged); a request with
     /// this off renders the same generation again in full.
     pub coarse_only: bool,
@@ -108,6 +111,7 @@ impl RenderWorker {
             settings.width,
             settings.height,
             settings.shade_back,
+            settings.object_rays,
             modes.clone(),
             self.coarse_only,
         );
@@ -148,7 +152,8 @@ impl RenderWorker {
     /// Whether the newest request has been fully rendered.
     pub fn is_idle(&self) -> bool {
         self.with_published(|p| {
-            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some())
+            // The normal-rule gap is part of what is shown (the toolbar), so idle waits for it.
+            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some() && p.normal_gap.is_some())
         })
     }
 
@@ -203,6 +208,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 passes: 0,
                 first_image: None,
                 full: None,
+                normal_gap: None,
             };
             *p = Some(new);
         }
@@ -258,6 +264,19 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
         } else {
             (0..frames.len()).all(render_one)
         };
+        let repaint = || {
+            if let Some(f) = shared.repaint.lock().unwrap_or_else(PoisonError::into_inner).as_ref() {
+                f();
+            }
+        };
+        if ok && let Ok(gap) = normal_rule_gap(&compiled, &job.settings, &cancel) {
+            if let Some(p) = shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_mut() {
+                if p.job.request == job.request {
+                    p.normal_gap = Some(gap);
+                }
+            }
+            repaint();
+        }
         if ok && log {
             shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_ref().inspect(|p| {
                 log::info!(

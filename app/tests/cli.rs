@@ -461,3 +461,40 @@ fn kill_9_during_fmt_o_leaves_the_old_file_and_no_temporary_file() {
     assert_eq!(std::fs::read_to_string(d.join("out.txt")).expect("read"), "old contents");
     assert_eq!(std::fs::read_to_string(d.join("out.png")).expect("read"), "old image");
 }
+
+#[test]
+fn object_rays_flag_in_both_spellings_keeps_or_breaks_the_depth_order() {
+    let d = temp_dir("object-rays");
+    let scene = repo().join("scenes/lecture/depth_t.txt");
+    let scene = scene.to_str().expect("utf-8 path");
+    let mut images = Vec::new();
+    for mode in ["unnormalized", "normalized", "normalized-no-rescale"] {
+        let (c, z) = (format!("{mode}.png"), format!("{mode}-depth.png"));
+        let o = tracelab(&["render", scene, "--size", "60", "60", "--output", &c, "--depth", "8", "16", &z, "--object-rays", mode], &d);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        let (cc, zc) = (format!("course-{mode}.png"), format!("course-{mode}-depth.png"));
+        let o = tracelab(&["-input", scene, "-size", "60", "60", "-output", &cc, "-depth", "8", "16", &zc, "-object_rays", mode], &d);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        let read = |f: &str| image::open(d.join(f)).expect("image").to_rgb8();
+        assert_eq!(read(&c), read(&cc), "{mode}: both spellings");
+        images.push((read(&c), read(&z)));
+    }
+    let max_diff = |a: &image::RgbImage, b: &image::RgbImage| {
+        a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0)
+    };
+    let [(c0, z0), (c1, z1), (c2, z2)] = images.try_into().expect("three modes");
+    // The two correct rules: the same images to rounding.
+    assert!(max_diff(&c0, &c1) <= 1 && max_diff(&z0, &z1) <= 1);
+    // Pixel (36, 29) looks at the small red sphere's centre, in front of the big blue one
+    // (world t 9 against 12); without rescaling red's t doubles and blue's is quartered.
+    let (good, bug) = (c0.get_pixel(36, 29), c2.get_pixel(36, 29));
+    assert!(good[0] > good[2] && bug[2] > bug[0], "red {good:?} then blue {bug:?}");
+    // Depth in [8, 16]: red at t = 9 is grey 223 (⌊(16 − 9)/8·255⌋), blue's t ≈ 3 is white.
+    let (zg, zb) = (z0.get_pixel(36, 29)[0], z2.get_pixel(36, 29)[0]);
+    assert!(zg.abs_diff(223) <= 2 && zb == 255, "depth {zg} then {zb}");
+    let o = tracelab(&["render", scene, "--output", "x.png", "--object-rays", "sideways"], &d);
+    assert_eq!(o.status.code(), Some(2));
+    let o = tracelab(&["-input", scene, "-size", "9", "9", "-output", "x.png", "-object_rays", "sideways"], &d);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-object_rays: expected unnormalized, normalized or normalized-no-rescale"), "{}", stderr(&o));
+}

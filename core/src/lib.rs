@@ -14,7 +14,7 @@ pub use format::{
 };
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
 pub use render::{
-    CompiledScene, Frame, NormalTransform, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
+    CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
     render_progressive,
 };
 pub use scene::{

@@ -55,7 +55,7 @@ fn assert_close(got: &[f32], want: &[f32]) {
 
 fn render(s: &Scene, w: u32, h: u32) -> Frame {
     let settings =
-        RenderSettings { width: w, height: h, shade_back: false, normal_transform: NormalTransform::Correct };
+        RenderSettings::new(w, h);
     render_frame(&compile(s), &settings)
 }
 
@@ -300,7 +300,7 @@ fn camera_inside_a_solid_sees_the_inside_of_the_result() {
     );
     let s = parse_scene(inside.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0;
     let settings =
-        RenderSettings { width: 16, height: 16, shade_back: true, normal_transform: NormalTransform::Correct };
+        RenderSettings { shade_back: true, ..RenderSettings::new(16, 16) };
     let f = render_frame(&compile(&s), &settings);
     assert!(f.samples.iter().all(|p| p.is_hit() && p.t > 0.0 && p.color[0] > 30), "every pixel sees the lit inside");
 }
@@ -327,7 +327,7 @@ fn normal_transform_mode_applies_to_csg_surfaces() {
     );
     let s = scene(&sheared);
     let at = |mode| {
-        render_frame(&compile(&s), &RenderSettings { width: 64, height: 48, shade_back: false, normal_transform: mode })
+        render_frame(&compile(&s), &RenderSettings { normal_transform: mode, ..RenderSettings::new(64, 48) })
     };
     let (correct, incorrect) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));
     assert!(hits(&correct) > 300);
@@ -340,7 +340,7 @@ fn normal_transform_mode_applies_to_csg_surfaces() {
     let at = |mode| {
         render_frame(
             &compile(&similar),
-            &RenderSettings { width: 64, height: 48, shade_back: false, normal_transform: mode },
+            &RenderSettings { normal_transform: mode, ..RenderSettings::new(64, 48) },
         )
     };
     let (a, b) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));

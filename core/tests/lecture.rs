@@ -9,7 +9,7 @@ use common::repo;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::{
-    Frame, MeshCache, NormalTransform, RenderSettings, Scene, View, compile, load_scene, render_frame,
+    Frame, MeshCache, NormalTransform, ObjectRays, RenderSettings, Scene, View, compile, load_scene, render_frame,
 };
 
 const SIZE: u32 = 128;
@@ -20,10 +20,16 @@ struct Figure {
     scene: &'static str,
     view: View,
     normal_transform: NormalTransform,
+    object_rays: ObjectRays,
 }
 
 const fn fig(golden: &'static str, scene: &'static str, view: View, normal_transform: NormalTransform) -> Figure {
-    Figure { golden, scene, view, normal_transform }
+    Figure { golden, scene, view, normal_transform, object_rays: ObjectRays::Unnormalized }
+}
+
+/// A figure of the depth-t question, rendered with a chosen object-ray rule.
+const fn fig_rays(golden: &'static str, scene: &'static str, object_rays: ObjectRays) -> Figure {
+    Figure { golden, scene, view: Color, normal_transform: Correct, object_rays }
 }
 
 use NormalTransform::{Correct, Incorrect};
@@ -46,6 +52,8 @@ const FIGURES: &[Figure] = &[
     fig("csg_intersection", "csg_intersection", Color, Correct),
     fig("csg_subtraction", "csg_subtraction", Color, Correct),
     fig("csg_die", "csg_die", Color, Correct),
+    fig_rays("depth_t_unnormalized", "depth_t", ObjectRays::Unnormalized),
+    fig_rays("depth_t_no_rescale", "depth_t", ObjectRays::NormalizedNoRescale),
 ];
 
 fn scene_path(name: &str) -> PathBuf {
@@ -62,7 +70,11 @@ fn load(name: &str) -> Scene {
 }
 
 fn render(scene: &Scene, normal_transform: NormalTransform) -> Frame {
-    let settings = RenderSettings { width: SIZE, height: SIZE, shade_back: false, normal_transform };
+    render_with(scene, normal_transform, ObjectRays::Unnormalized)
+}
+
+fn render_with(scene: &Scene, normal_transform: NormalTransform, object_rays: ObjectRays) -> Frame {
+    let settings = RenderSettings { normal_transform, object_rays, ..RenderSettings::new(SIZE, SIZE) };
     render_frame(&compile(scene), &settings)
 }
 
@@ -86,7 +98,7 @@ fn lecture_scenes_match_their_reviewed_golden_images() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/lecture");
     let mut failures = Vec::new();
     for f in FIGURES {
-        let frame = render(&load(f.scene), f.normal_transform);
+        let frame = render_with(&load(f.scene), f.normal_transform, f.object_rays);
         assert!(frame.samples.iter().any(|s| s.is_hit()), "{}: nothing visible", f.golden);
         let rgb = frame.rgb8(f.view, (0.0, 1.0));
         let path = dir.join(format!("{}.png", f.golden));

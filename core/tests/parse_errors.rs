@@ -191,6 +191,25 @@ fn many_missing_meshes_are_capped_like_parse_errors() {
     assert!(e[20].message.len() < 40);
 }
 
+/// The parser's errors and the meshes' share one cap: 20 shown in all, one "… and N more".
+#[test]
+fn parse_errors_and_missing_meshes_share_one_cap() {
+    let spheres: String = (0..25).map(|i| format!(" Sphere {{ center {i} 0 0 }}\n")).collect();
+    let meshes: String = (0..5).map(|i| format!(" TriangleMesh {{ obj_file gone_{i}.obj }}\n")).collect();
+    let text = body(&format!("Group {{\n numObjects 30\n MaterialIndex 0\n{spheres}{meshes}}}\n"));
+    let more = |d: &tracelab_core::Diagnostics| -> usize {
+        d.errors().find_map(|e| e.message.strip_prefix("… and ")?.strip_suffix(" more errors")?.parse().ok()).unwrap_or(0)
+    };
+    let parsed = parse_scene_unresolved(text.as_bytes(), "t.txt");
+    let parse_errors = parsed.diagnostics.errors().count() - 1 + more(&parsed.diagnostics);
+    assert!(parse_errors >= 25, "{}", parsed.diagnostics);
+    let out = parse(&text);
+    let e: Vec<_> = out.diagnostics.errors().collect();
+    assert_eq!(e.len(), 21, "{}", out.diagnostics);
+    assert_eq!(more(&out.diagnostics), parse_errors + 5 - 20, "{}", out.diagnostics);
+    assert!(e[20].message.starts_with("… and "), "the summary stays last: {}", out.diagnostics);
+}
+
 #[test]
 fn broken_obj_reports_the_obj_line() {
     let dir = std::env::temp_dir().join(format!("tracelab-broken-obj-{}", std::process::id()));

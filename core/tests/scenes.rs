@@ -52,7 +52,7 @@ fn differing_pixels(a: &Frame, b: &Frame) -> usize {
 }
 
 fn render(scene: &Scene, mode: NormalTransform, shade_back: bool) -> Frame {
-    let settings = RenderSettings { width: 64, height: 48, shade_back, normal_transform: mode };
+    let settings = RenderSettings { shade_back, normal_transform: mode, ..RenderSettings::new(64, 48) };
     render_frame(&compile(scene), &settings)
 }
 

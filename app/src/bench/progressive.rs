@@ -8,7 +8,7 @@ use tracelab_core::render::SharedFrame;
 use glam::Vec3;
 use tracelab_core::render::render_coarse;
 use tracelab_core::render::{Tracing, render_progressive_traced};
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, render_progressive};
+use tracelab_core::{CompiledScene, RenderSettings, Scene, render_progressive};
 
 use crate::gui::bounds::world_bounds;
 use crate::gui::navigation::orbit;
@@ -23,12 +23,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let (w, h) = (b.size[0], b.size[1]);
     check_size(w, h)?;
     let scene = load_scene(Some(&b.scene))?;
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        shade_back: false,
-        normal_transform: NormalTransform::Correct,
-    };
+    let settings = RenderSettings::new(w, h);
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
     let tracing = if b.single_rays { Tracing::SingleRays } else { Tracing::Packets };

@@ -3,14 +3,15 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use tracelab_core::NormalTransform;
+use tracelab_core::{NormalTransform, ObjectRays};
 
 use super::render::RenderJob;
 use super::values::{parse_f32, parse_u32};
 use crate::exit::usage;
 
 /// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
-/// -shade_back`, plus tracelab's `-normal_transform correct|incorrect`.
+/// -shade_back`, plus tracelab's `-normal_transform correct|incorrect` and
+/// `-object_rays unnormalized|normalized|normalized-no-rescale`.
 pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     let mut job = RenderJob {
         scene: None,
@@ -21,6 +22,7 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
         depth: None,
         shade_back: false,
         normal_transform: NormalTransform::Correct,
+        object_rays: ObjectRays::Unnormalized,
     };
     let mut it = args.iter();
     let take = |it: &mut std::slice::Iter<OsString>, flag: &str| -> anyhow::Result<OsString> {
@@ -50,6 +52,15 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
                     Some("incorrect") => NormalTransform::Incorrect,
                     _ => return Err(usage(format!("-normal_transform: expected correct or incorrect, found \"{}\"", v.display()))),
                 }
+            }
+            "-object_rays" => {
+                let v = take(&mut it, a)?;
+                job.object_rays = v.to_str().and_then(ObjectRays::from_name).ok_or_else(|| {
+                    usage(format!(
+                        "-object_rays: expected unnormalized, normalized or normalized-no-rescale, found \"{}\"",
+                        v.display()
+                    ))
+                })?;
             }
             _ => return Err(usage(format!("unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back)", arg.display()))),
         }

@@ -4,8 +4,11 @@
 //!
 //! Exit codes: 0 success, 1 scene or I/O error, 2 usage error (see `crate::exit`).
 
+mod animate;
 mod course;
+mod diff;
 mod fmt;
+mod inspect;
 mod render;
 mod values;
 
@@ -46,6 +49,14 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
     Render(RenderArgs),
+    /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).
+    /// Sweep one number of a Transform op over N frames: a PNG sequence and an animated PNG.
+    Animate(animate::AnimateArgs),
+    /// Compare your image with the reference for a course command line (after --): heat map, worst pixels.
+    #[command(long_about = diff::LONG_ABOUT)]
+    Diff(diff::DiffArgs),
+    #[command(long_about = inspect::LONG_ABOUT)]
+    Inspect(inspect::InspectArgs),
     /// Rewrite a scene file in canonical form.
     Fmt {
         scene: PathBuf,
@@ -78,6 +89,7 @@ fn report(e: &anyhow::Error) -> ExitCode {
         }
         Some(Exit::UsagePrinted) => ExitCode::from(2),
         Some(Exit::OutputClosed) => ExitCode::SUCCESS,
+        Some(Exit::Differs) => ExitCode::from(3),
         None => {
             let m = e.to_string();
             print_err(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }));
@@ -92,8 +104,9 @@ fn print_err(text: &str) {
 }
 
 pub fn run(args: &[OsString]) -> anyhow::Result<()> {
-    // The course's raytracer flags start with a single dash: `-input`, `-size`, ...
-    if args.iter().skip(1).any(|a| a == "-input") {
+    // The course's raytracer flags start with a single dash: `-input`, `-size`, ... A course
+    // line after `--` belongs to a subcommand (`tracelab diff mine.png -- -input ...`).
+    if args.iter().skip(1).take_while(|a| *a != "--").any(|a| a == "-input") {
         let job = parse_course_args(args.get(1..).unwrap_or_default())?;
         return run_render(&job);
     }
@@ -110,6 +123,9 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
     };
     match cli.command {
         Some(Command::Render(r)) => run_render(&render::render_job(r)?),
+        Some(Command::Inspect(a)) => inspect::run_inspect(&a),
+        Some(Command::Diff(a)) => diff::run_diff(&a),
+        Some(Command::Animate(a)) => animate::run_animate(&a),
         Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
         Some(Command::BenchProgressive(b)) => {

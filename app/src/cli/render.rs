@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
 use tracelab_core::render::{SharedFrame, render_full};
-use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, View};
+use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
 use super::values::parse_f32;
 use crate::exit::{check_size, usage};
@@ -38,6 +38,29 @@ pub struct RenderArgs {
     /// How normals go through Transforms.
     #[arg(long, value_enum, default_value_t = NormalMode::Correct)]
     pub normal_transform: NormalMode,
+    /// How rays go into object space, and which t is kept as the depth.
+    #[arg(long, value_enum, default_value_t = ObjectRaysMode::Unnormalized)]
+    pub object_rays: ObjectRaysMode,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjectRaysMode {
+    /// M⁻¹d kept as it is: t is the same in object and world space.
+    Unnormalized,
+    /// M⁻¹d normalised, and t rescaled to world space after intersection (same image).
+    Normalized,
+    /// M⁻¹d normalised and t not rescaled: the lecture's bug (wrong depth and occlusion).
+    NormalizedNoRescale,
+}
+
+impl From<ObjectRaysMode> for ObjectRays {
+    fn from(m: ObjectRaysMode) -> Self {
+        match m {
+            ObjectRaysMode::Unnormalized => ObjectRays::Unnormalized,
+            ObjectRaysMode::Normalized => ObjectRays::Normalized,
+            ObjectRaysMode::NormalizedNoRescale => ObjectRays::NormalizedNoRescale,
+        }
+    }
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +91,7 @@ pub struct RenderJob {
     pub depth: Option<(f32, f32, PathBuf)>,
     pub shade_back: bool,
     pub normal_transform: NormalTransform,
+    pub object_rays: ObjectRays,
 }
 
 pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
@@ -89,6 +113,7 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
         depth,
         shade_back: r.shade_back,
         normal_transform: r.normal_transform.into(),
+        object_rays: r.object_rays.into(),
     };
     if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
         return Err(usage("nothing to write: give --output, --normals or --depth"));
@@ -119,6 +144,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         height: job.height,
         shade_back: job.shade_back,
         normal_transform: job.normal_transform,
+        object_rays: job.object_rays,
     };
     let frame = render_with_progress(&compiled, &settings);
     let save = |view: View, depth: (f32, f32), path: &Path| {
@@ -137,7 +163,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
 }
 
 /// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
-fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
+pub(super) fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
     let target = Arc::new(SharedFrame::new());
     let done = Arc::new(AtomicBool::new(false));
     let watcher = std::io::stderr().is_terminal().then(|| {

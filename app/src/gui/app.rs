@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use tracelab_core::Scene;
+use tracelab_core::{NodeKind, Scene};
 use tracelab_core::render::RayStory;
 
 use crate::document::edit::Edit;
@@ -28,7 +28,10 @@ use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
 use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
-use crate::gui::panels::{inspector, pixel_inspector, status, tree};
+use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree};
+use crate::gui::animation_dialog::{self, AnimationForm};
+use crate::gui::lecture;
+use crate::gui::ray_diagram::Orbit;
 
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -66,6 +69,15 @@ pub struct TracelabApp {
     /// Which pixel that is and the render it was traced in: every new render traces it again.
     pub inspected: Option<Inspected>,
     pub pixel_inspector_open: bool,
+    /// The Ray panel (world and object space diagrams) in the dock, beside the story.
+    pub ray_panel_open: bool,
+    /// File › Export animation's form, while open, and the export under way.
+    pub animation: Option<AnimationForm>,
+    pub animation_running: Option<animation_dialog::Running>,
+    /// The Lecture menu's figure on show, for its caption.
+    pub lecture: Option<usize>,
+    /// How each Ray diagram (world, object) is turned.
+    pub ray_orbits: [Orbit; 2],
     pub dialog: Option<FileDialog>,
     native: Option<NativeDialog>,
     native_dialogs: bool,
@@ -112,6 +124,11 @@ impl TracelabApp {
             story: None,
             inspected: None,
             pixel_inspector_open: false,
+            ray_panel_open: true,
+            ray_orbits: [Orbit::default(); 2],
+            lecture: None,
+            animation: None,
+            animation_running: None,
             dialog: None,
             native: None,
             native_dialogs: opts.native_dialogs,
@@ -222,9 +239,43 @@ impl TracelabApp {
                 }
             }
             AppCommand::Inspect { frame, x, row } => self.inspect(frame, x, row),
-            AppCommand::New => self.new_document(),
+            AppCommand::New => {
+                self.lecture = None;
+                self.new_document();
+            }
             AppCommand::OpenDialog => self.show_file_dialog(Purpose::Open),
-            AppCommand::Open(p) => self.open(&p),
+            AppCommand::Open(p) => {
+                self.lecture = None;
+                self.open(&p);
+            }
+            AppCommand::OpenLecture(i) => {
+                if let Some(f) = lecture::FIGURES.get(i) {
+                    f.apply(&mut self.view);
+                    self.open(&f.path());
+                    self.lecture = Some(i);
+                }
+            }
+            AppCommand::CloseCaption => self.lecture = None,
+            AppCommand::AnimationDialog => match self.doc.selection {
+                Some(Selection::Node(id)) if matches!(self.doc.scene.graph.get(id).map(|n| &n.kind), Some(NodeKind::Transform(_))) => {
+                    self.animation = Some(AnimationForm::new(id));
+                }
+                _ => self.doc.messages.push("Export animation: select a Transform first".into()),
+            },
+            AppCommand::StartAnimation(form) => {
+                if self.animation_running.is_none() {
+                    let size = self.view.fixed_size.unwrap_or(self.viewport.shown_size);
+                    let settings = Viewport::settings(&self.view, size);
+                    self.animation_running = Some(animation_dialog::Running::start(Arc::new(self.doc.scene.clone()), &form, settings));
+                    self.animation = Some(form);
+                }
+            }
+            AppCommand::CancelAnimation => {
+                if let Some(r) = &self.animation_running {
+                    r.cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            }
+            AppCommand::CloseAnimationDialog => self.animation = None,
             AppCommand::Save => self.save(),
             AppCommand::SaveAsDialog => self.show_file_dialog(Purpose::SaveAs),
             AppCommand::SaveAs(p) => self.save_as(&p),
@@ -245,6 +296,7 @@ impl TracelabApp {
                 self.doc.redo();
             }
             AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
+            AppCommand::ShowRayPanel(open) => self.ray_panel_open = open,
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {
                 Some(Selection::Node(id)) => self.frame_node(id),
@@ -605,12 +657,23 @@ impl TracelabApp {
                 menu::button(ui, true, AppCommand::SaveAsDialog, &mut out);
                 menu::button(ui, self.doc.path.is_some(), AppCommand::Reload, &mut out);
                 menu::button(ui, true, AppCommand::ExportDialog, &mut out);
+                let transform = matches!(self.doc.selection, Some(Selection::Node(id)) if matches!(self.doc.scene.graph.get(id).map(|n| &n.kind), Some(NodeKind::Transform(_))));
+                menu::button(ui, transform, AppCommand::AnimationDialog, &mut out)
+                    .on_disabled_hover_text("Select a Transform: one of its ops' numbers is swept");
                 ui.separator();
                 menu::button(ui, true, AppCommand::Quit, &mut out);
             });
             ui.menu_button("Edit", |ui| {
                 menu::button(ui, self.doc.can_undo(), AppCommand::Undo, &mut out);
                 menu::button(ui, self.doc.can_redo(), AppCommand::Redo, &mut out);
+            });
+            ui.menu_button("Lecture", |ui| {
+                for (i, f) in lecture::FIGURES.iter().enumerate() {
+                    if ui.button(f.caption).on_hover_text(f.look[0]).clicked() {
+                        out.push(AppCommand::OpenLecture(i));
+                        ui.close();
+                    }
+                }
             });
             ui.menu_button("View", |ui| {
                 let mut open = self.pixel_inspector_open;
@@ -625,6 +688,10 @@ impl TracelabApp {
                     menu::button(ui, true, AppCommand::AxisView(v), &mut out);
                 }
                 ui.separator();
+                let mut ray = self.ray_panel_open;
+                if ui.checkbox(&mut ray, "Ray panel (in the pixel inspector)").changed() {
+                    out.push(AppCommand::ShowRayPanel(ray));
+                }
                 if menu::button(ui, true, AppCommand::ResetLayout, &mut out)
                     .on_hover_text("Panels back to their first sizes")
                     .clicked()
@@ -708,6 +775,18 @@ impl TracelabApp {
     }
 
     fn dialogs(&mut self, ctx: &egui::Context) {
+        if let Some(msg) = self.animation_running.as_ref().and_then(animation_dialog::Running::poll) {
+            self.animation_running = None;
+            self.doc.messages.push(msg.unwrap_or_else(|e| e));
+        }
+        if let Some(form) = &mut self.animation
+            && let Some(c) = animation_dialog::ui(ctx, form, &self.doc.scene, self.animation_running.as_ref())
+        {
+            self.queue(c);
+        }
+        if self.animation_running.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
         if let Some(answer) = self.native.as_ref().and_then(NativeDialog::poll)
             && let Some(d) = self.native.take()
         {
@@ -933,10 +1012,26 @@ impl TracelabApp {
             self.layout.dock_panel(height).show(ui, |ui| {
                 ui.horizontal(|ui| {
                     ui.strong("Pixel inspector");
+                    let mut ray = self.ray_panel_open;
+                    if ui.checkbox(&mut ray, "Ray diagrams").changed() {
+                        asked.push(AppCommand::ShowRayPanel(ray));
+                    }
                     if ui.small_button("Close").clicked() {
                         asked.push(AppCommand::ShowPixelInspector(false));
                     }
                 });
+                if self.ray_panel_open {
+                    // The lecture's figure, docked beside the story: never over the image.
+                    let width = ui.available_width();
+                    egui::Panel::right(self.layout.panel_id("ray"))
+                        .resizable(true)
+                        .default_size((width * 0.5).max(200.0))
+                        .max_size((width - 200.0).max(200.0))
+                        .show(ui, |ui| {
+                            let story = self.story.as_ref().map(|(s, sc)| (s, sc.as_ref()));
+                            ray_panel::ui(ui, story, &mut self.ray_orbits);
+                        });
+                }
                 egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| match &self.story {
                     Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
                     None => {
@@ -948,7 +1043,21 @@ impl TracelabApp {
         let mut pick = None;
         let mut size = (1, 1);
         egui::CentralPanel::default().show(ui, |ui| {
-            Viewport::toolbar(ui, &mut self.view);
+            let gap = self.worker.with_published(|p| p.and_then(|p| p.normal_gap));
+            Viewport::toolbar(ui, &mut self.view, gap);
+            if let Some(f) = self.lecture.and_then(|i| lecture::FIGURES.get(i)) {
+                ui.separator();
+                ui.horizontal(|ui| {
+                    ui.vertical(|ui| {
+                        ui.strong(f.caption);
+                        ui.label(f.look[0]);
+                        ui.label(f.look[1]);
+                    });
+                    if ui.small_button("×").on_hover_text("Hide the caption").clicked() {
+                        asked.push(AppCommand::CloseCaption);
+                    }
+                });
+            }
             ui.separator();
             size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
             self.render_size = size;

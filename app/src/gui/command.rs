@@ -8,6 +8,7 @@ use tracelab_core::NodeId;
 
 use crate::document::Selection;
 use crate::document::edit::Edit;
+use crate::animation::AnimationForm;
 use crate::gui::navigation::AxisView;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +27,15 @@ pub enum AppCommand {
     /// Ask for a file to open.
     OpenDialog,
     Open(PathBuf),
+    /// Open a figure of the Lecture menu (index into `lecture::FIGURES`) and set its view.
+    OpenLecture(usize),
+    /// Hide the lecture figure's caption.
+    CloseCaption,
+    /// Open File › Export animation for the selected Transform.
+    AnimationDialog,
+    StartAnimation(AnimationForm),
+    CancelAnimation,
+    CloseAnimationDialog,
     Save,
     /// Ask where to save.
     SaveAsDialog,
@@ -39,6 +49,8 @@ pub enum AppCommand {
     Undo,
     Redo,
     ShowPixelInspector(bool),
+    /// The Ray panel's diagrams beside the pixel inspector's story.
+    ShowRayPanel(bool),
     ResetLayout,
     /// Move the camera to show the selected node whole (F).
     FrameSelected,

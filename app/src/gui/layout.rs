@@ -30,6 +30,11 @@ impl Layout {
         if self.epoch == 0 { name.to_string() } else { format!("{name}#{}", self.epoch) }
     }
 
+    /// The id of a panel nested in one of these (the Ray panel in the dock).
+    pub fn panel_id(&self, name: &str) -> String {
+        self.id(name)
+    }
+
     /// The scene tree, left, in a window `total` points wide.
     pub fn tree_panel(&self, total: f32) -> egui::Panel {
         let inspector = if self.inspector > 0.0 { self.inspector } else { INSPECTOR_WIDTH };

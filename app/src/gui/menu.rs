@@ -31,6 +31,7 @@ pub static ENTRIES: &[Entry] = &[
     Entry { command: AppCommand::SaveAsDialog, label: "Save As…", keys: &[keys(CMD_SHIFT, Key::S)], keys_text: "Ctrl+Shift+S" },
     Entry { command: AppCommand::Reload, label: "Reload from disk", keys: &[], keys_text: "" },
     Entry { command: AppCommand::ExportDialog, label: "Export view…", keys: &[], keys_text: "" },
+    Entry { command: AppCommand::AnimationDialog, label: "Export animation…", keys: &[], keys_text: "" },
     Entry { command: AppCommand::Quit, label: "Quit", keys: &[keys(CMD, Key::Q)], keys_text: "Ctrl+Q" },
     Entry { command: AppCommand::Undo, label: "Undo", keys: &[keys(CMD, Key::Z)], keys_text: "Ctrl+Z" },
     Entry {

@@ -1,6 +1,7 @@
 //! The desktop editor (eframe): the app that wires the document, the panels and the render
 //! worker together.
 
+pub mod animation_dialog;
 pub mod app;
 pub mod bounds;
 pub mod command;
@@ -9,12 +10,14 @@ pub mod file_dialog;
 pub mod file_watch;
 pub mod gizmo;
 pub mod layout;
+pub mod lecture;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
 pub mod navigation;
 pub mod overlays;
 pub mod panels;
+pub mod ray_diagram;
 pub mod settings;
 pub mod view_tools;
 pub mod widgets;

@@ -33,6 +33,19 @@ pub struct ParseOutcome {
     pub lost_comments: Vec<Diagnostic>,
     /// Each TriangleMesh node still to be loaded, with where its file name stands.
     pub meshes: Vec<MeshRef>,
+    /// The diagnostics counted but not shown (the last `summaries` of `diagnostics` say so),
+    /// for the resolve step to go on counting within the same cap.
+    pub(crate) unshown: UnshownSummary,
+}
+
+/// Errors and warnings left out after the first [`MAX_SHOWN`] of each, and where the first
+/// of them stands.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct UnshownSummary {
+    pub errors: (usize, Option<Located>),
+    pub warnings: (usize, Option<Located>),
+    /// How many "… and N more" lines end `diagnostics`.
+    pub summaries: usize,
 }
 
 impl ParseOutcome {
@@ -63,6 +76,7 @@ pub fn load_scene_unresolved(path: &Path) -> ParseOutcome {
         diagnostics: Diagnostics(vec![Diagnostic { severity: Severity::Error, file: name.clone(), line: 0, col: 0, message }]),
         lost_comments: Vec::new(),
         meshes: Vec::new(),
+        unshown: UnshownSummary::default(),
     };
     match read_capped(path, MAX_SCENE_BYTES) {
         Ok(Some(bytes)) => parse_scene_unresolved(&bytes, &name),
@@ -101,7 +115,13 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
                 valid_up_to,
                 format!("this is not a text scene file: found {what}"),
             );
-            return ParseOutcome { scene: None, diagnostics: Diagnostics(vec![d]), lost_comments: Vec::new(), meshes: Vec::new() };
+            return ParseOutcome {
+                scene: None,
+                diagnostics: Diagnostics(vec![d]),
+                lost_comments: Vec::new(),
+                meshes: Vec::new(),
+                unshown: UnshownSummary::default(),
+            };
         }
     };
     let mut p = Parser {
@@ -381,15 +401,23 @@ impl<'a> Parser<'a> {
     }
 
     /// "… and N more", located at the first diagnostic left out.
-    fn summarise_unshown(&mut self) {
+    fn summarise_unshown(&mut self) -> UnshownSummary {
         let u = &self.unshown;
+        let mut out = UnshownSummary::default();
         for (severity, (n, at), what) in [(Severity::Error, u.errors, "error"), (Severity::Warning, u.warnings, "warning")] {
             if n > 0 {
                 let s = if n == 1 { "" } else { "s" };
                 let d = self.src.diagnostic(severity, at, format!("… and {n} more {what}{s}"));
+                let place = Some(Located { file: d.file.clone(), line: d.line, col: d.col });
+                match severity {
+                    Severity::Error => out.errors = (n, place),
+                    Severity::Warning => out.warnings = (n, place),
+                }
+                out.summaries += 1;
                 self.diags.push(d);
             }
         }
+        out
     }
 
     /// Skips to just past the `}` that closes a block whose `{` was already read.
@@ -1322,7 +1350,7 @@ impl<'a> Parser<'a> {
                 self.warn(*at, "no MaterialIndex applies to this object; it uses the default grey material");
             }
         }
-        self.summarise_unshown();
+        let unshown = self.summarise_unshown();
         let scene = if self.fatal {
             None
         } else {
@@ -1336,7 +1364,7 @@ impl<'a> Parser<'a> {
             })
         };
         let meshes = self.mesh_refs(scene.as_ref());
-        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments, meshes }
+        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments, meshes, unshown }
     }
 
     /// The TriangleMesh nodes with their file names and locations (also for a scene too

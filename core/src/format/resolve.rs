@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use super::diagnostic::{Diagnostic, Severity, escape_controls};
 use super::obj::{MeshCache, resolve_obj_path};
-use super::parser::{Located, MAX_SHOWN, ParseOutcome};
+use super::parser::{Located, MAX_SHOWN, ParseOutcome, UnshownSummary};
 use crate::scene::{MeshSlot, NodeKind, NotClosed, check_closed};
 
 /// Loads every mesh `out` still lists, through `cache`, relative to `base_dir` first (then
@@ -17,7 +17,17 @@ use crate::scene::{MeshSlot, NodeKind, NotClosed, check_closed};
 /// cannot be loaded leaves the scene usable: its node becomes [`MeshSlot::Failed`] and
 /// renders nothing. Running it twice does nothing the second time.
 pub fn resolve_meshes(out: &mut ParseOutcome, base_dir: Option<&Path>, cache: &mut MeshCache) {
-    let mut report = Capped::default();
+    // Go on counting within the parser's cap: its "… and N more" lines are rewritten at the end.
+    let u = std::mem::take(&mut out.unshown);
+    let kept = out.diagnostics.0.len() - u.summaries.min(out.diagnostics.0.len());
+    out.diagnostics.0.truncate(kept);
+    let shown = |s: Severity| out.diagnostics.0.iter().filter(|d| d.severity == s).count();
+    let mut report = Capped {
+        shown: [shown(Severity::Error), shown(Severity::Warning)],
+        unshown: [u.errors.0, u.warnings.0],
+        first_unshown: [u.errors.1, u.warnings.1],
+        ..Capped::default()
+    };
     // Closedness per loaded mesh (by address), so a mesh used many times is checked once.
     let mut closed: HashMap<usize, Result<(), NotClosed>> = HashMap::new();
     for r in std::mem::take(&mut out.meshes) {
@@ -55,38 +65,50 @@ pub fn resolve_meshes(out: &mut ParseOutcome, base_dir: Option<&Path>, cache: &m
             *mesh = slot;
         }
     }
-    out.diagnostics.0.extend(report.finish());
+    let (diags, unshown) = report.finish();
+    out.diagnostics.0.extend(diags);
+    out.unshown = unshown;
 }
 
 /// At most `MAX_SHOWN` errors and as many warnings, then "… and N more", as the parser
 /// reports: a scene of a million meshes that are all missing prints a screenful.
 #[derive(Default)]
 struct Capped {
-    shown: Vec<Diagnostic>,
-    counts: [usize; 2],
+    new: Vec<Diagnostic>,
+    /// Per severity (errors, warnings): shown so far, counted but not shown, and where the
+    /// first of those stands.
+    shown: [usize; 2],
+    unshown: [usize; 2],
     first_unshown: [Option<Located>; 2],
 }
 
 impl Capped {
     fn push(&mut self, severity: Severity, at: &Located, message: String) {
         let k = usize::from(severity == Severity::Warning);
-        self.counts[k] += 1;
-        if self.counts[k] <= MAX_SHOWN {
-            self.shown.push(diagnostic(severity, at, &message));
-        } else if self.first_unshown[k].is_none() {
-            self.first_unshown[k] = Some(at.clone());
+        if self.shown[k] < MAX_SHOWN {
+            self.shown[k] += 1;
+            self.new.push(diagnostic(severity, at, &message));
+        } else {
+            self.unshown[k] += 1;
+            self.first_unshown[k].get_or_insert_with(|| at.clone());
         }
     }
 
-    fn finish(mut self) -> Vec<Diagnostic> {
+    fn finish(mut self) -> (Vec<Diagnostic>, UnshownSummary) {
+        let mut summary = UnshownSummary::default();
         for (k, (severity, what)) in [(Severity::Error, "error"), (Severity::Warning, "warning")].into_iter().enumerate() {
-            if let Some(at) = &self.first_unshown[k] {
-                let n = self.counts[k] - MAX_SHOWN;
+            let n = self.unshown[k];
+            if let Some(at) = self.first_unshown[k].clone().filter(|_| n > 0) {
                 let s = if n == 1 { "" } else { "s" };
-                self.shown.push(diagnostic(severity, at, &format!("… and {n} more {what}{s}")));
+                self.new.push(diagnostic(severity, &at, &format!("… and {n} more {what}{s}")));
+                summary.summaries += 1;
+                match severity {
+                    Severity::Error => summary.errors = (n, Some(at)),
+                    Severity::Warning => summary.warnings = (n, Some(at)),
+                }
             }
         }
-        self.shown
+        (self.new, summary)
     }
 }
 

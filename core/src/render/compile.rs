@@ -60,9 +60,9 @@ pub struct CompiledScene {
     pub lights: Vec<(Vec3, Vec3)>,
     pub materials: Vec<Vec3>,
     pub objects: Vec<Object>,
-    bvh: Bvh,
+    pub(super) bvh: Bvh,
     /// Objects with no finite bounds (planes), tested for every ray.
-    unbounded: Vec<u32>,
+    pub(super) unbounded: Vec<u32>,
     /// The one object of a scene that holds a single mesh and nothing else: rays go straight
     /// to it, since the mesh tests its own box first (in object space, needing no second
     /// reciprocal of the direction).
@@ -258,23 +258,7 @@ impl CompiledScene {
             }
             None => ray,
         };
-        match &o.shape {
-            Shape::Sphere { center, radius } => intersect_sphere(r, *center, *radius, t_min, t_max).map(|t| (t, 0)),
-            Shape::Plane { normal, offset } => intersect_plane(r, *normal, *offset, t_min, t_max).map(|t| (t, 0)),
-            Shape::Triangle { vertices: [a, b, c], .. } => {
-                intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0))
-            }
-            Shape::Mesh(_) => None, // handled above
-            Shape::Box { min, max } => {
-                let (t0, f0, t1, f1) = box_span(r, *min, *max)?;
-                if t0 > t_min && t0 < t_max {
-                    Some((t0, f0))
-                } else {
-                    (t1 > t_min && t1 < t_max).then_some((t1, f1))
-                }
-            }
-            Shape::Csg(tree) => tree.intersect(r, t_min, t_max),
-        }
+        shape_hit(&o.shape, r, t_min, t_max)
     }
 
     /// The object-space normal at a hit (not normalised for spheres' scale; unit otherwise).
@@ -352,6 +336,31 @@ impl CompiledScene {
             .and_then(|o| self.materials.get(o.material as usize))
             .copied()
             .unwrap_or(DEFAULT_MATERIAL_COLOR)
+    }
+}
+
+/// A shape's closest hit for a ray already in its own space: (t along that ray, prim).
+#[inline(always)]
+pub(super) fn shape_hit(shape: &Shape, r: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
+    match shape {
+        Shape::Sphere { center, radius } => intersect_sphere(r, *center, *radius, t_min, t_max).map(|t| (t, 0)),
+        Shape::Plane { normal, offset } => intersect_plane(r, *normal, *offset, t_min, t_max).map(|t| (t, 0)),
+        Shape::Triangle { vertices: [a, b, c], .. } => {
+            intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0))
+        }
+        Shape::Mesh(m) => m
+            .accel
+            .closest_hit(Vec3A::from(r.origin), Vec3A::from(r.direction), t_min, t_max)
+            .map(|h| (h.t, h.triangle)),
+        Shape::Box { min, max } => {
+            let (t0, f0, t1, f1) = box_span(r, *min, *max)?;
+            if t0 > t_min && t0 < t_max {
+                Some((t0, f0))
+            } else {
+                (t1 > t_min && t1 < t_max).then_some((t1, f1))
+            }
+        }
+        Shape::Csg(tree) => tree.intersect(r, t_min, t_max),
     }
 }
 

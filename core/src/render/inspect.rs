@@ -6,7 +6,7 @@ use glam::{DMat4, Mat4, Vec3};
 
 use super::compile::CompiledScene;
 use super::shade::{ShadeInfo, shade_hit};
-use super::{NormalTransform, RenderSettings};
+use super::{NormalTransform, ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 use crate::scene::validate::compose_f64;
 use crate::scene::{NodeId, NodeKind, Scene};
@@ -19,6 +19,9 @@ pub struct PathStep {
     /// World-from-local of the space this node's children live in (identity for the root
     /// Group; a Transform multiplies its ops in).
     pub world_from_local: Mat4,
+    /// A Transform's own matrix M (its ops composed in f64), from its children's space to
+    /// its parent's; `None` for other nodes.
+    pub transform: Option<DMat4>,
     /// The world ray expressed in that space: origin as a point, direction unnormalised, so
     /// the hit's t is the same here as in world space.
     pub ray: Ray,
@@ -29,9 +32,17 @@ pub struct HitStory {
     pub node: NodeId,
     /// Root first; the last step is the object hit itself.
     pub path: Vec<PathStep>,
+    /// The world ray parameter of the point hit: the same along every step's ray.
     pub t: f32,
     /// The ray in the object's own space (the last step's ray).
     pub object_ray: Ray,
+    /// The rule the renderer used, and what it traced and kept: under a normalising rule
+    /// `traced_ray` has a unit direction and `t_object` = t·|M⁻¹d|; `t_used` is the t kept
+    /// for depth and occlusion (the object-space one under the bug).
+    pub object_rays: ObjectRays,
+    pub traced_ray: Ray,
+    pub t_object: f32,
+    pub t_used: f32,
     pub object_point: Vec3,
     pub world_point: Vec3,
     pub object_normal: Vec3,
@@ -76,8 +87,9 @@ pub fn inspect_pixel(
         compiled
             .camera
             .pixel_ray(x, row, settings.width.max(1), settings.height.max(1));
+    let rule = settings.object_rays;
     let hit = compiled
-        .intersect(&world_ray, compiled.camera.t_min(), f32::INFINITY)
+        .intersect_with(&world_ray, compiled.camera.t_min(), f32::INFINITY, rule)
         .and_then(|hit| {
             // For a CSG hit, the operand whose surface it is (its path holds the CSG node).
             let node = compiled.hit_node(&hit)?;
@@ -87,21 +99,32 @@ pub fn inspect_pixel(
             let mut path = Vec::with_capacity(ids.len());
             for id in ids {
                 let n = scene.graph.get(id)?;
-                if let NodeKind::Transform(ops) = &n.kind {
-                    m *= compose_f64(ops);
+                let transform = match &n.kind {
+                    NodeKind::Transform(ops) => Some(compose_f64(ops)),
+                    _ => None,
+                };
+                if let Some(t) = transform {
+                    m *= t;
                 }
                 path.push(PathStep {
                     node: id,
                     kind: n.kind.name(),
                     world_from_local: m.as_mat4(),
+                    transform,
                     ray: world_ray.transformed(&m.inverse().as_mat4()),
                 });
             }
             let object_ray = path.last().map_or(world_ray, |s| s.ray);
-            let object_normal = compiled.object_normal(&world_ray, &hit);
-            let normal_correct = compiled.world_normal(&world_ray, &hit, NormalTransform::Correct);
-            let normal_incorrect =
-                compiled.world_normal(&world_ray, &hit, NormalTransform::Incorrect);
+            let ot = compiled.object_t(&world_ray, &hit, rule);
+            // CSG operands carry their transforms inside the solid: they keep the plain rule.
+            let own_xf = compiled.objects.get(hit.object as usize).is_some_and(|o| o.xf.is_some());
+            let traced_ray = if own_xf { ot.traced } else { object_ray };
+            // The normal routines evaluate their ray at hit.t: give them one that lands on the
+            // point really hit under every rule.
+            let at_hit = compiled.ray_for_hit_point(&world_ray, &hit, rule);
+            let object_normal = compiled.object_normal(&at_hit, &hit);
+            let normal_correct = compiled.world_normal(&at_hit, &hit, NormalTransform::Correct);
+            let normal_incorrect = compiled.world_normal(&at_hit, &hit, NormalTransform::Incorrect);
             // atan2 of sine and cosine: acos of a dot product near 1 turns rounding into
             // hundredths of a degree where the rules agree exactly.
             let angle = normal_correct
@@ -111,10 +134,14 @@ pub fn inspect_pixel(
             Some(HitStory {
                 node,
                 path,
-                t: hit.t,
+                t: ot.t_world,
                 object_ray,
-                object_point: object_ray.at(hit.t),
-                world_point: world_ray.at(hit.t),
+                object_rays: rule,
+                traced_ray,
+                t_object: ot.t_object,
+                t_used: ot.t_used,
+                object_point: object_ray.at(ot.t_world),
+                world_point: world_ray.at(ot.t_world),
                 object_normal,
                 normal_correct,
                 normal_incorrect,

@@ -7,18 +7,24 @@ pub mod csg;
 mod frame;
 mod inspect;
 mod limits;
+mod object_rays;
 mod progressive;
+mod rule_gap;
 mod shade;
+mod similitude;
 
 pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
+pub use object_rays::{ObjectRays, ObjectT};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
 pub use progressive::{
     Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced, render_full, render_progressive,
     render_progressive_traced,
 };
+pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
+pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 
 /// How world normals are obtained from object-space ones under a Transform.
@@ -40,11 +46,20 @@ pub struct RenderSettings {
     /// back-facing hit is black.
     pub shade_back: bool,
     pub normal_transform: NormalTransform,
+    /// How rays are moved into object space, and which t is kept (the lecture's "what to do
+    /// about the depth t").
+    pub object_rays: ObjectRays,
 }
 
 impl RenderSettings {
     pub fn new(width: u32, height: u32) -> Self {
-        RenderSettings { width, height, shade_back: false, normal_transform: NormalTransform::Correct }
+        RenderSettings {
+            width,
+            height,
+            shade_back: false,
+            normal_transform: NormalTransform::Correct,
+            object_rays: ObjectRays::Unnormalized,
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::compile::CompiledScene;
 use super::frame::{Frame, Sample, sample_from};
 use super::shade::shade_fast;
-use super::RenderSettings;
+use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
 const TILE: u32 = 64;
@@ -91,7 +91,12 @@ pub enum Tracing {
 /// Traces one pixel's ray and shades it.
 #[inline]
 fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray) -> Sample {
-    let hit = scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY);
+    // The default rule stays on the fast path, exactly as before the other rules existed.
+    let hit = if s.object_rays == ObjectRays::Unnormalized {
+        scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY)
+    } else {
+        scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
+    };
     shade_sample(scene, s, &ray, hit)
 }
 
@@ -260,7 +265,12 @@ fn render_scales(
             let mut local: Vec<(u32, u32, Sample)> = Vec::new();
             let traced_before = |x: u32, row: u32| coarser.is_some_and(|c| x % c == 0 && row % c == 0);
             match tracing {
-                Tracing::SingleRays => {
+                // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
+                Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
+                    let px = pixels_to_trace((x0, y0, x1, y1), scale, traced_before);
+                    trace_packets(scene, settings, &rays, &px, &mut local);
+                }
+                _ => {
                     for row in (y0..y1).step_by(scale as usize) {
                         let row_rays = rays.row(row);
                         for x in (x0..x1).step_by(scale as usize) {
@@ -269,10 +279,6 @@ fn render_scales(
                             }
                         }
                     }
-                }
-                Tracing::Packets => {
-                    let px = pixels_to_trace((x0, y0, x1, y1), scale, traced_before);
-                    trace_packets(scene, settings, &rays, &px, &mut local);
                 }
             }
             let mut f = target.lock();

@@ -31,7 +31,8 @@ pub struct ShadeInfo {
 }
 
 pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> ShadeInfo {
-    let normal = scene.world_normal(ray, hit, settings.normal_transform);
+    let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
+    let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);
     let kd = scene.hit_color(hit);
     let back_facing = ray.direction.dot(normal) > 0.0;
     let mut info = ShadeInfo {
@@ -66,7 +67,9 @@ pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderS
 /// Colour only, without collecting terms (the hot path).
 #[inline]
 pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> (Vec3, Vec3) {
-    let normal = scene.world_normal(ray, hit, settings.normal_transform);
+    // The normal at the point really hit, whatever t the depth rule kept.
+    let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
+    let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);
     let kd = scene.hit_color(hit);
     let mut n = normal;
     if ray.direction.dot(normal) > 0.0 {

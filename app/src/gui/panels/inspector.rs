@@ -308,6 +308,7 @@ fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, as
             .collect();
         ui.small(breadcrumb(&names));
     }
+    similitude_lines(ui, doc, id);
     // MaterialIndex
     if id != g.root() {
         let mats = doc.scene.materials.len() as u32;
@@ -582,6 +583,18 @@ fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
         *m = Mat4::from_cols_array_2d(&rows).transpose();
     }
     changed
+}
+
+/// "When does M·n happen to work?": the selected Transform's and the chain's similitude test.
+fn similitude_lines(ui: &mut egui::Ui, doc: &Document, id: NodeId) {
+    let (own, chain) = crate::story::node_similitudes(&doc.scene, id);
+    let ascii = crate::gui::panels::pixel_inspector::ascii_math;
+    if let Some(t) = own {
+        ui.label(format!("This Transform: {}", ascii(&t.summary())));
+    }
+    if id != doc.scene.graph.root() {
+        ui.label(format!("World from here: {}", ascii(&chain.summary())));
+    }
 }
 
 /// The path from the root to the selection, "Group › Transform › Sphere"; a deep one keeps

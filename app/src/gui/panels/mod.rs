@@ -4,6 +4,7 @@
 pub mod inspector;
 pub mod loading;
 pub mod pixel_inspector;
+pub mod ray_panel;
 pub mod status;
 pub mod tree;
 pub mod viewport;

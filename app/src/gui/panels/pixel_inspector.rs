@@ -6,9 +6,10 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use tracelab_core::render::{RayStory, inspect_pixel};
-use tracelab_core::{NodeKind, NormalTransform, RenderSettings, Scene};
+use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
 
 use crate::render_worker::Published;
+use crate::story::{HitReport, TransformReport, hit_report, transform_lines};
 
 /// The pixel being inspected, and the render its story was traced in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,97 +56,79 @@ fn v(v: Vec3) -> String {
     format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
 }
 
+fn a(xyz: [f32; 3]) -> String {
+    v(Vec3::from_array(xyz))
+}
+
+/// egui's default fonts have no superscripts: M⁻¹ is drawn as M^-1, (M⁻¹)ᵀ as (M^-1)^T.
+pub fn ascii_math(s: &str) -> String {
+    s.replace("⁻¹", "^-1").replace('ᵀ', "^T")
+}
+
+/// M, M⁻¹, (M⁻¹)ᵀ and the similitude line of one Transform, in a monospace block.
+pub fn matrices_ui(ui: &mut egui::Ui, t: &TransformReport) {
+    let text = transform_lines("", t).iter().map(|l| ascii_math(l)).collect::<Vec<_>>().join("\n");
+    ui.label(egui::RichText::new(text).monospace().small());
+}
+
+/// Which t the renderer kept, in words.
+pub fn t_line(h: &HitReport, rule: ObjectRays) -> String {
+    format!(
+        "t: world {:.5}, object {:.5} (|M^-1 d| = {:.4}); rule {}: kept the {} t, {:.5}",
+        h.t.world, h.t.object, h.t.object_direction_length, rule.name(), h.t.used_is, h.t.used
+    )
+}
+
 /// Draws the story. `scene` is the snapshot the story was traced in.
 pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
-    let RayStory {
-        x,
-        row,
-        world_ray,
-        hit,
-        background,
-        normal_transform,
-    } = story;
+    let RayStory { x, row, world_ray, hit, background, normal_transform } = story;
     ui.label(format!("Pixel ({x}, {row}), rows from the top"));
-    ui.label(format!(
-        "World ray: origin {} direction {}",
-        v(world_ray.origin),
-        v(world_ray.direction)
-    ));
-    let Some(h) = hit else {
-        ui.label(format!(
-            "Missed every object: background {}",
-            v(*background)
-        ));
+    ui.label(format!("World ray: origin {} direction {}", v(world_ray.origin), v(world_ray.direction)));
+    let Some(story_hit) = hit else {
+        ui.label(format!("Missed every object: background {}", v(*background)));
         return;
     };
+    let h = hit_report(scene, story_hit, *normal_transform);
     ui.separator();
-    ui.strong(format!(
-        "Hit {} (node #{}) at t = {:.5}",
-        scene.graph.get(h.node).map_or("?", |n| n.kind.name()),
-        h.node.0,
-        h.t
-    ));
-    ui.label("Path, with the ray in each space (t is the same in every one):");
-    egui::Grid::new("path").striped(true).show(ui, |ui| {
-        for step in &h.path {
-            let what = match scene.graph.get(step.node).map(|n| &n.kind) {
-                Some(NodeKind::Transform(ops)) => {
-                    format!(
-                        "Transform: {}",
-                        ops.iter()
-                            .map(|o| o.summary())
-                            .collect::<Vec<_>>()
-                            .join(" · ")
-                    )
-                }
-                _ => step.kind.to_string(),
-            };
-            ui.label(what);
-            ui.label(format!(
-                "o {}  d {}",
-                v(step.ray.origin),
-                v(step.ray.direction)
-            ));
-            ui.end_row();
-        }
-    });
+    ui.strong(format!("Hit {} at t = {:.5}", h.node.label, h.t.world));
+    ui.label(t_line(&h, story_hit.object_rays));
+    ui.label("Path, with the ray in each space (direction not renormalised: t is the same in every one):");
+    // One block per node, label then ray then matrices: a two-column grid squeezed the ray
+    // into one number a line beside the Ray panel.
+    for step in &h.path {
+        ui.label(egui::RichText::new(&step.node.label).strong());
+        ui.indent(("step", step.node.id), |ui| {
+            ui.label(format!("origin {}  direction {}", a(step.ray.origin), a(step.ray.direction)));
+            if let Some(t) = &step.transform {
+                matrices_ui(ui, t);
+            }
+        });
+    }
+    ui.label(format!("World from object: {}", ascii_math(&h.world_from_object.similitude.summary)));
     ui.separator();
     egui::Grid::new("hit").show(ui, |ui| {
-        let mut row = |a: &str, b: String| {
-            ui.label(a);
-            ui.label(b);
+        let mut row = |key: &str, value: String| {
+            ui.label(key);
+            ui.label(value);
             ui.end_row();
         };
-        row("hit point (object)", v(h.object_point));
-        row("hit point (world)", v(h.world_point));
-        row("normal (object)", v(h.object_normal));
-        row("world normal by (M^-1)^T", v(h.normal_correct));
-        row("world normal by M", v(h.normal_incorrect));
-        row(
-            "angle between them",
-            format!("{:.3}°", h.normal_angle_degrees),
-        );
+        row("hit point (object)", a(h.point_object));
+        row("hit point (world)", a(h.point_world));
+        row("normal (object)", a(h.normal.object));
+        row("world normal by (M^-1)^T", a(h.normal.world_correct));
+        row("world normal by M", a(h.normal.world_incorrect));
+        row("angle between them", format!("{:.3}°", h.normal.angle_degrees));
         let rule = match normal_transform {
             NormalTransform::Correct => "(M^-1)^T",
             NormalTransform::Incorrect => "M",
         };
-        row(
-            "shading uses",
-            format!(
-                "{rule}{}",
-                if h.shade.back_facing {
-                    ", back-facing"
-                } else {
-                    ""
-                }
-            ),
-        );
-        row("diffuse k_d", v(h.shade.diffuse));
-        row("ambient · k_d", v(h.shade.ambient_term));
-        for (i, l) in h.shade.lights.iter().enumerate() {
+        row("shading uses", format!("{rule}{}", if h.shading.back_facing { ", back-facing" } else { "" }));
+        row("diffuse k_d", a(h.shading.diffuse));
+        row("ambient · k_d", a(h.shading.ambient));
+        for (i, l) in h.shading.lights.iter().enumerate() {
             row(&format!("light {i}: L·N"), format!("{:.4}", l.l_dot_n));
-            row(&format!("light {i}: max(L·N,0)·c·k_d"), v(l.contribution));
+            row(&format!("light {i}: max(L·N,0)·c·k_d"), a(l.contribution));
         }
-        row("colour (sum)", v(h.shade.color));
+        row("colour (sum)", a(h.shading.color));
     });
 }

@@ -2,8 +2,8 @@
 //! range and size controls, the images themselves (uploaded as textures when the worker has
 //! new pixels), and picking.
 
-use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size};
-use tracelab_core::{NormalTransform, RenderSettings, View};
+use tracelab_core::render::{MAX_IMAGE_SIDE, NormalGap, check_image_size};
+use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
@@ -34,6 +34,8 @@ pub struct ViewSettings {
     pub tab: Tab,
     pub compare: Compare,
     pub normal_transform: NormalTransform,
+    /// How rays enter object space and which t is kept (the lecture's depth question).
+    pub object_rays: ObjectRays,
     pub shade_back: bool,
     pub depth: (f32, f32),
     /// `None`: follow the view's size in pixels.
@@ -52,6 +54,7 @@ impl Default for ViewSettings {
             tab: Tab::Color,
             compare: Compare::Off,
             normal_transform: NormalTransform::Correct,
+            object_rays: ObjectRays::Unnormalized,
             shade_back: false,
             depth: (8.0, 18.0),
             fixed_size: None,
@@ -59,6 +62,15 @@ impl Default for ViewSettings {
             gizmo_axes: Axes::World,
             overlays: true,
         }
+    }
+}
+
+/// The depth-t rules as the toolbar names them.
+pub fn object_rays_label(r: ObjectRays) -> &'static str {
+    match r {
+        ObjectRays::Unnormalized => "unnormalised: t_OS = t_WS",
+        ObjectRays::Normalized => "normalised, t rescaled",
+        ObjectRays::NormalizedNoRescale => "normalised, t not rescaled (bug)",
     }
 }
 
@@ -168,8 +180,9 @@ pub struct Viewport {
 }
 
 impl Viewport {
-    /// The toolbar; returns true when a setting changed.
-    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings) {
+    /// The toolbar. `gap` is the largest angle between the two normal rules over the
+    /// pixels of the image on screen, once computed.
+    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings, gap: Option<NormalGap>) {
         ui.horizontal_wrapped(|ui| {
             for (tab, name) in [
                 (Tab::Color, "Colour"),
@@ -194,6 +207,12 @@ impl Viewport {
                     "Incorrect M",
                 );
             });
+            match gap {
+                Some(g) if g.degrees == 0.0 => ui.label("0° apart: all similitudes"),
+                Some(g) => ui.label(format!("up to {:.2}° apart", g.degrees)),
+                None => ui.label("…"),
+            }
+            .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels (0 exactly when every transform on screen is a similitude)");
             ui.separator();
             egui::ComboBox::from_label("compare")
                 .selected_text(match s.compare {
@@ -208,6 +227,14 @@ impl Viewport {
                 });
         });
         ui.horizontal_wrapped(|ui| {
+            // The lecture's "what to do about the depth t", for both images when comparing.
+            egui::ComboBox::from_label("depth t")
+                .selected_text(object_rays_label(s.object_rays))
+                .show_ui(ui, |ui| {
+                    for r in ObjectRays::ALL {
+                        ui.selectable_value(&mut s.object_rays, r, object_rays_label(r));
+                    }
+                });
             ui.checkbox(&mut s.overlays, "gizmo & overlays");
             ui.add_enabled_ui(s.overlays, |ui| {
                 ui.selectable_value(&mut s.gizmo_axes, Axes::World, "world axes")
@@ -543,6 +570,7 @@ impl Viewport {
             height: size.1.max(1),
             shade_back: s.shade_back,
             normal_transform: s.normal_transform,
+            object_rays: s.object_rays,
         }
     }
 }

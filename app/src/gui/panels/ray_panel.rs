@@ -1,0 +1,107 @@
+//! The Ray panel: the picked pixel's ray drawn twice, as the lecture's "World Space / Object
+//! Space" figure — in world space with the hit object, both normals, the tangent plane and
+//! the lights; in the hit primitive's own space with M⁻¹o, M⁻¹d at its own length and the
+//! object normal. Drag in either diagram to orbit it.
+
+use egui::{Color32, Pos2, Stroke};
+use glam::{Vec2, Vec3};
+use tracelab_core::Scene;
+use tracelab_core::render::RayStory;
+
+use crate::gui::ray_diagram::{Diagram, Orbit, Role, Shape, diagrams};
+
+fn color(role: Role) -> Color32 {
+    match role {
+        Role::Eye => Color32::from_rgb(200, 200, 200),
+        Role::Ray => Color32::from_rgb(240, 240, 120),
+        Role::Outline => Color32::from_rgb(110, 140, 200),
+        Role::Hit => Color32::WHITE,
+        Role::NormalCorrect => Color32::from_rgb(90, 220, 90),
+        Role::NormalIncorrect => Color32::from_rgb(240, 80, 80),
+        Role::Tangent => Color32::from_rgba_unmultiplied(90, 220, 90, 90),
+        Role::Light => Color32::from_rgb(255, 190, 60),
+        Role::Direction => Color32::from_rgb(255, 140, 255),
+    }
+}
+
+/// One diagram in `rect`; a drag on it turns `orbit`.
+fn draw(ui: &mut egui::Ui, id: &str, title: &str, d: &Diagram, orbit: &mut Orbit, size: egui::Vec2) {
+    ui.vertical(|ui| {
+        ui.strong(title);
+        let (rect, response) = ui.allocate_exact_size(size, egui::Sense::drag());
+        if response.dragged() {
+            let delta = response.drag_delta();
+            orbit.drag(Vec2::new(delta.x, delta.y));
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                orbit.scroll(scroll);
+            }
+        }
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 4.0, Color32::from_gray(24));
+        let (center, radius) = d.bounds();
+        let half = rect.width().min(rect.height()) * 0.5 - 14.0;
+        let sc = Vec2::new(rect.center().x, rect.center().y);
+        let proj = |p: Vec3| {
+            let q = orbit.project(p, center, radius, sc, half.max(10.0));
+            Pos2::new(q.x, q.y)
+        };
+        for item in &d.items {
+            let c = color(item.role);
+            let at = match &item.shape {
+                Shape::Point(p) => {
+                    painter.circle_filled(proj(*p), 3.5, c);
+                    proj(*p)
+                }
+                Shape::Line(ps) => {
+                    let width = if item.role == Role::Ray { 2.0 } else { 1.0 };
+                    painter.line(ps.iter().map(|p| proj(*p)).collect(), Stroke::new(width, c));
+                    ps.last().map_or(Pos2::ZERO, |p| proj(*p))
+                }
+                Shape::Arrow(a, b) => {
+                    let (pa, pb) = (proj(*a), proj(*b));
+                    painter.arrow(pa, pb - pa, Stroke::new(2.0, c));
+                    pb
+                }
+            };
+            if let Some(l) = &item.label {
+                painter.text(at + egui::vec2(4.0, -4.0), egui::Align2::LEFT_BOTTOM, l, egui::FontId::proportional(11.0), c);
+            }
+        }
+        // Say where the origin is when it lies outside the view.
+        if let Some(o) = d.items.iter().find(|i| i.role == Role::Eye)
+            && let Shape::Point(p) = o.shape
+            && !rect.contains(proj(p))
+        {
+            painter.text(
+                rect.left_bottom() + egui::vec2(6.0, -6.0),
+                egui::Align2::LEFT_BOTTOM,
+                format!("ray origin ({:.2}, {:.2}, {:.2}) off view: scroll to zoom out", p.x, p.y, p.z),
+                egui::FontId::proportional(11.0),
+                color(Role::Eye),
+            );
+        }
+        response.on_hover_text(format!("{id}: drag to orbit, scroll to zoom"));
+    });
+}
+
+/// Both diagrams side by side, or a line saying why there are none.
+pub fn ui(ui: &mut egui::Ui, story: Option<(&RayStory, &Scene)>, orbits: &mut [Orbit; 2]) {
+    let Some((story, scene)) = story else {
+        ui.label("Click a pixel in the render view to draw its ray.");
+        return;
+    };
+    let Some((world, object)) = diagrams(scene, story) else {
+        ui.label("The ray misses every object: nothing to draw.");
+        return;
+    };
+    let avail = ui.available_size();
+    let side = egui::vec2(((avail.x - 16.0) / 2.0).max(120.0), (avail.y - 24.0).max(120.0));
+    let [w, o] = orbits;
+    ui.horizontal(|ui| {
+        draw(ui, "world", "World space", &world, w, side);
+        draw(ui, "object", "Object space (of the primitive hit)", &object, o, side);
+    });
+}

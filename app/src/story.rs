@@ -1,0 +1,431 @@
+//! One pixel's story as plain data: what `tracelab inspect` prints (as text or, through
+//! serde, as the JSON schema of docs/inspect-json.md) and what the editor's pixel inspector
+//! and Ray panel show. Built from core's `RayStory`, with the tree's node labels, each
+//! Transform's M, M⁻¹ and (M⁻¹)ᵀ, and the similitude test.
+
+use glam::{DMat3, DMat4, Vec3};
+use serde::Serialize;
+use tracelab_core::render::{Breaks, HitStory, RayStory, SimilitudeTest, quantize, similitude};
+use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
+
+use crate::gui::panels::tree::node_label;
+
+/// Bumped when a field changes meaning or goes away (adding one keeps it).
+pub const SCHEMA: &str = "tracelab-inspect/1";
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PixelReport {
+    pub schema: &'static str,
+    pub size: [u32; 2],
+    /// Column from the left and row from the top, as images store them.
+    pub pixel: PixelAt,
+    pub settings: SettingsReport,
+    pub world_ray: RayReport,
+    /// `None` (JSON null) when the ray misses everything.
+    pub hit: Option<HitReport>,
+    pub background: [f32; 3],
+    /// The colour before quantisation: the shading's sum, or the background.
+    pub color: [f32; 3],
+    /// The image's bytes for that colour: ⌊c·255⌋ clamped, as the course's Image writes.
+    pub rgb8: [u8; 3],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PixelAt {
+    pub x: u32,
+    pub row: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SettingsReport {
+    pub object_rays: &'static str,
+    pub normal_transform: &'static str,
+    pub shade_back: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RayReport {
+    pub origin: [f32; 3],
+    pub direction: [f32; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NodeReport {
+    pub id: u32,
+    pub kind: &'static str,
+    /// As the scene tree shows it, e.g. `Transform: Scale(1.5, 0.5, 1)`.
+    pub label: String,
+}
+
+/// A 4×4 affine matrix as its 3×3 linear part (rows) and its translation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AffineReport {
+    pub linear: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TransformReport {
+    #[serde(rename = "M")]
+    pub m: AffineReport,
+    #[serde(rename = "M_inverse")]
+    pub m_inverse: AffineReport,
+    /// (M⁻¹)ᵀ's 3×3: normals see no translation.
+    #[serde(rename = "M_inverse_transpose")]
+    pub m_inverse_transpose: [[f64; 3]; 3],
+    pub similitude: SimilitudeReport,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SimilitudeReport {
+    pub is_similitude: bool,
+    /// (M⁻¹)ᵀ = λ·M for a similitude; null otherwise.
+    pub lambda: Option<f64>,
+    pub reflects: bool,
+    /// |M·x̂|, |M·ŷ|, |M·ẑ|.
+    pub axis_scales: [f64; 3],
+    /// Degrees between the images of the axis pairs (x,y), (y,z), (z,x).
+    pub axis_angles_degrees: [f64; 3],
+    /// What breaks it: `{"kind": "non_uniform_scale", "min", "max"}` or
+    /// `{"kind": "shear", "angle_degrees"}`.
+    pub breaks: Vec<BreakReport>,
+    pub summary: String,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum BreakReport {
+    NonUniformScale { min: f64, max: f64 },
+    Shear { angle_degrees: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepReport {
+    pub node: NodeReport,
+    /// The node's own matrix, for a Transform; null for others.
+    pub transform: Option<TransformReport>,
+    /// The world ray in the space this node's children live in (direction not renormalised).
+    pub ray: RayReport,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TReport {
+    /// The world ray parameter of the point hit (the same along every step's ray).
+    pub world: f32,
+    /// t along the object-space ray as the renderer traced it.
+    pub object: f32,
+    /// The t the renderer kept for depth and occlusion.
+    pub used: f32,
+    /// "world" or "object": which of the two `used` is.
+    pub used_is: &'static str,
+    /// |M⁻¹d|: how much longer the object-space direction is before any normalising.
+    pub object_direction_length: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NormalReport {
+    pub object: [f32; 3],
+    /// (M⁻¹)ᵀ·n, normalised.
+    pub world_correct: [f32; 3],
+    /// M·n, normalised.
+    pub world_incorrect: [f32; 3],
+    pub angle_degrees: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LightReport {
+    /// Toward the light, normalised.
+    pub direction: [f32; 3],
+    pub l_dot_n: f32,
+    /// max(L·N, 0)·c_light·k_d.
+    pub contribution: [f32; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShadingReport {
+    /// "correct" or "incorrect": the rule the colour was shaded with.
+    pub normal_rule: &'static str,
+    /// The normal shaded with (flipped toward the eye under shade-back).
+    pub normal: [f32; 3],
+    pub back_facing: bool,
+    pub diffuse: [f32; 3],
+    /// c_ambient·k_d.
+    pub ambient: [f32; 3],
+    pub lights: Vec<LightReport>,
+    /// ambient + Σ lights.
+    pub color: [f32; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HitReport {
+    pub node: NodeReport,
+    /// Root first; the last step is the object hit.
+    pub path: Vec<StepReport>,
+    /// The composed world-from-object matrix, with its similitude test.
+    pub world_from_object: TransformReport,
+    pub t: TReport,
+    /// The object-space ray the intersection routine saw.
+    pub traced_ray: RayReport,
+    pub point_world: [f32; 3],
+    pub point_object: [f32; 3],
+    pub normal: NormalReport,
+    pub shading: ShadingReport,
+}
+
+fn a3(v: Vec3) -> [f32; 3] {
+    v.to_array()
+}
+
+fn ray(r: &tracelab_core::geometry::Ray) -> RayReport {
+    RayReport { origin: a3(r.origin), direction: a3(r.direction) }
+}
+
+fn rows3(m: DMat3) -> [[f64; 3]; 3] {
+    [m.row(0).to_array(), m.row(1).to_array(), m.row(2).to_array()]
+}
+
+fn affine(m: DMat4) -> AffineReport {
+    AffineReport { linear: rows3(DMat3::from_mat4(m)), translation: m.w_axis.truncate().to_array() }
+}
+
+pub fn similitude_report(t: &SimilitudeTest) -> SimilitudeReport {
+    SimilitudeReport {
+        is_similitude: t.is_similitude(),
+        lambda: t.lambda,
+        reflects: t.reflects,
+        axis_scales: t.axis_scales,
+        axis_angles_degrees: t.axis_angles,
+        breaks: t
+            .breaks
+            .iter()
+            .map(|b| match *b {
+                Breaks::NonUniformScale { min, max } => BreakReport::NonUniformScale { min, max },
+                Breaks::Shear { angle_degrees } => BreakReport::Shear { angle_degrees },
+            })
+            .collect(),
+        summary: t.summary(),
+    }
+}
+
+/// M, M⁻¹, (M⁻¹)ᵀ and the similitude test of one matrix (inverted in f64, as the renderer).
+pub fn transform_report(m: DMat4) -> TransformReport {
+    let inv = m.inverse();
+    let linear = DMat3::from_mat4(m);
+    TransformReport {
+        m: affine(m),
+        m_inverse: affine(inv),
+        m_inverse_transpose: rows3(DMat3::from_mat4(inv).transpose()),
+        similitude: similitude_report(&similitude(linear)),
+    }
+}
+
+pub fn object_rays_name(r: ObjectRays) -> &'static str {
+    r.name()
+}
+
+pub fn normal_rule_name(n: NormalTransform) -> &'static str {
+    match n {
+        NormalTransform::Correct => "correct",
+        NormalTransform::Incorrect => "incorrect",
+    }
+}
+
+fn node(scene: &Scene, id: tracelab_core::NodeId) -> NodeReport {
+    let n = scene.graph.get(id);
+    NodeReport {
+        id: id.0,
+        kind: n.map_or("?", |n| n.kind.name()),
+        label: n.map_or_else(|| "?".into(), |n| node_label(&n.kind, n.children.len())),
+    }
+}
+
+/// The hit part of the report (what the editor's panels draw).
+pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> HitReport {
+    let mut world_from_object = DMat4::IDENTITY;
+    let path = h
+        .path
+        .iter()
+        .map(|s| {
+            if let Some(m) = s.transform {
+                world_from_object *= m;
+            }
+            StepReport { node: node(scene, s.node), transform: s.transform.map(transform_report), ray: ray(&s.ray) }
+        })
+        .collect();
+    let object_direction_length = h.object_ray.direction.length();
+    HitReport {
+        node: node(scene, h.node),
+        path,
+        world_from_object: transform_report(world_from_object),
+        t: TReport {
+            world: h.t,
+            object: h.t_object,
+            used: h.t_used,
+            used_is: if h.object_rays == ObjectRays::NormalizedNoRescale && h.t_used != h.t { "object" } else { "world" },
+            object_direction_length,
+        },
+        traced_ray: ray(&h.traced_ray),
+        point_world: a3(h.world_point),
+        point_object: a3(h.object_point),
+        normal: NormalReport {
+            object: a3(h.object_normal),
+            world_correct: a3(h.normal_correct),
+            world_incorrect: a3(h.normal_incorrect),
+            angle_degrees: h.normal_angle_degrees,
+        },
+        shading: ShadingReport {
+            normal_rule: normal_rule_name(normal_rule),
+            normal: a3(h.shade.shading_normal),
+            back_facing: h.shade.back_facing,
+            diffuse: a3(h.shade.diffuse),
+            ambient: a3(h.shade.ambient_term),
+            lights: h
+                .shade
+                .lights
+                .iter()
+                .map(|l| LightReport { direction: a3(l.l), l_dot_n: l.l_dot_n, contribution: a3(l.contribution) })
+                .collect(),
+            color: a3(h.shade.color),
+        },
+    }
+}
+
+/// The report of a story traced with `settings` in `scene`.
+pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) -> PixelReport {
+    let color = story.color();
+    PixelReport {
+        schema: SCHEMA,
+        size: [settings.width, settings.height],
+        pixel: PixelAt { x: story.x, row: story.row },
+        settings: SettingsReport {
+            object_rays: object_rays_name(settings.object_rays),
+            normal_transform: normal_rule_name(settings.normal_transform),
+            shade_back: settings.shade_back,
+        },
+        world_ray: ray(&story.world_ray),
+        hit: story.hit.as_ref().map(|h| hit_report(scene, h, story.normal_transform)),
+        background: a3(story.background),
+        color: a3(color),
+        rgb8: [quantize(color.x), quantize(color.y), quantize(color.z)],
+    }
+}
+
+fn v3(v: [f32; 3]) -> String {
+    format!("({:.5}, {:.5}, {:.5})", v[0], v[1], v[2])
+}
+
+fn d3(v: [f64; 3]) -> String {
+    // + 0.0 turns −0 into 0: a sign on a zero only distracts.
+    format!("{:>10.5} {:>10.5} {:>10.5}", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0)
+}
+
+fn matrix_lines(out: &mut Vec<String>, indent: &str, name: &str, linear: &[[f64; 3]; 3], translation: Option<[f64; 3]>) {
+    for (i, r) in linear.iter().enumerate() {
+        let head = if i == 0 { format!("{name:<9}") } else { " ".repeat(9) };
+        let t = match translation {
+            Some(t) => format!(" | {:>10.5}", t[i]),
+            None => String::new(),
+        };
+        out.push(format!("{indent}{head}[{}]{t}", d3(*r)));
+    }
+}
+
+/// M, M⁻¹ and (M⁻¹)ᵀ as text rows: 3×3 linear part, then the translation after a bar.
+pub fn transform_lines(indent: &str, t: &TransformReport) -> Vec<String> {
+    let mut out = Vec::new();
+    matrix_lines(&mut out, indent, "M", &t.m.linear, Some(t.m.translation));
+    matrix_lines(&mut out, indent, "M⁻¹", &t.m_inverse.linear, Some(t.m_inverse.translation));
+    matrix_lines(&mut out, indent, "(M⁻¹)ᵀ", &t.m_inverse_transpose, None);
+    out.push(format!("{indent}{}", t.similitude.summary));
+    out
+}
+
+/// The report as the text `tracelab inspect` prints.
+pub fn report_text(r: &PixelReport) -> String {
+    let mut out = Vec::new();
+    out.push(format!(
+        "pixel ({}, {}) of {}×{} (x from the left, row from the top); object rays {}; normal transform {}{}",
+        r.pixel.x,
+        r.pixel.row,
+        r.size[0],
+        r.size[1],
+        r.settings.object_rays,
+        r.settings.normal_transform,
+        if r.settings.shade_back { "; shade back" } else { "" }
+    ));
+    out.push(format!("world ray: origin {} direction {}", v3(r.world_ray.origin), v3(r.world_ray.direction)));
+    let Some(h) = &r.hit else {
+        out.push(format!("missed every object: background {}", v3(r.background)));
+        out.push(format!("colour {} -> bytes {:?}", v3(r.color), r.rgb8));
+        return out.join("\n") + "\n";
+    };
+    out.push(format!("hit: {} (node {})", h.node.label, h.node.id));
+    out.push("path (the ray in each space; direction not renormalised, so t is the same):".into());
+    for s in &h.path {
+        out.push(format!("  {}", s.node.label));
+        if let Some(t) = &s.transform {
+            out.extend(transform_lines("      ", t));
+        }
+        out.push(format!("      ray: origin {} direction {}", v3(s.ray.origin), v3(s.ray.direction)));
+    }
+    out.push("world from object (composed):".into());
+    out.extend(transform_lines("      ", &h.world_from_object));
+    out.push(format!(
+        "t: world {:.6}, object {:.6} (|M⁻¹d| = {:.6}); the renderer kept {:.6}, the {} t",
+        h.t.world, h.t.object, h.t.object_direction_length, h.t.used, h.t.used_is
+    ));
+    out.push(format!("traced ray (object space): origin {} direction {}", v3(h.traced_ray.origin), v3(h.traced_ray.direction)));
+    out.push(format!("hit point: world {} object {}", v3(h.point_world), v3(h.point_object)));
+    out.push(format!("normal: object {}", v3(h.normal.object)));
+    out.push(format!("        world by (M⁻¹)ᵀ {}", v3(h.normal.world_correct)));
+    out.push(format!("        world by M      {}", v3(h.normal.world_incorrect)));
+    out.push(format!("        angle between them {:.4}°", h.normal.angle_degrees));
+    let sh = &h.shading;
+    out.push(format!(
+        "shading by the {} rule{}: k_d {}",
+        sh.normal_rule,
+        if sh.back_facing { " (back-facing)" } else { "" },
+        v3(sh.diffuse)
+    ));
+    out.push(format!("  ambient·k_d            {}", v3(sh.ambient)));
+    for (i, l) in sh.lights.iter().enumerate() {
+        out.push(format!("  light {i}: L·N = {:.5}  {}", l.l_dot_n, v3(l.contribution)));
+    }
+    out.push(format!("  sum                    {} -> bytes {:?}", v3(r.color), r.rgb8));
+    out.join("\n") + "\n"
+}
+
+/// One line for a pixel: what the ray hit, at which t, with which normal (for `tracelab diff`).
+pub fn one_line(r: &PixelReport) -> String {
+    let Some(h) = &r.hit else {
+        return format!("the ray misses everything: background {}", v3(r.background));
+    };
+    let kept = if h.t.used_is == "object" { format!(" (kept the object-space t {:.4})", h.t.used) } else { String::new() };
+    let n = if h.shading.normal_rule == "correct" { h.normal.world_correct } else { h.normal.world_incorrect };
+    let rule = if h.shading.normal_rule == "correct" { "(M⁻¹)ᵀ" } else { "M" };
+    let other = if h.normal.angle_degrees > 0.01 {
+        format!(", {:.2}° from the other rule's", h.normal.angle_degrees)
+    } else {
+        String::new()
+    };
+    format!("{} at t = {:.4}{kept}, normal by {rule} {}{other}", h.node.label, h.t.world, v3(n))
+}
+
+/// For a node of the scene: its own similitude test when it is a Transform, and that of the
+/// world-from-object chain down to it (every Transform above it, and itself), in f64.
+pub fn node_similitudes(scene: &Scene, id: tracelab_core::NodeId) -> (Option<SimilitudeTest>, SimilitudeTest) {
+    use tracelab_core::NodeKind;
+    use tracelab_core::scene::validate::compose_f64;
+    let g = &scene.graph;
+    let mut chain = DMat4::IDENTITY;
+    for p in g.path_to(id).unwrap_or_default() {
+        if let Some(NodeKind::Transform(ops)) = g.get(p).map(|n| &n.kind) {
+            chain *= compose_f64(ops);
+        }
+    }
+    let own = match g.get(id).map(|n| &n.kind) {
+        Some(NodeKind::Transform(ops)) => Some(similitude(DMat3::from_mat4(compose_f64(ops)))),
+        _ => None,
+    };
+    (own, similitude(DMat3::from_mat4(chain)))
+}

@@ -1,0 +1,142 @@
+//! The editor's teaching views (issue 14) driven as a user would, with egui_kittest: the
+//! Lecture menu, the depth-t switch, the Ray panel and the animation export. No GPU needed.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use tracelab::document::Selection;
+use tracelab::gui::command::AppCommand;
+use tracelab::gui::{AppOptions, TracelabApp};
+use tracelab_core::{NodeKind, ObjectRays};
+
+fn harness(size: (u32, u32)) -> Harness<'static, TracelabApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: None, fixed_size: Some(size), ..AppOptions::default() }))
+}
+
+fn settle(h: &mut Harness<'static, TracelabApp>) {
+    let start = Instant::now();
+    loop {
+        h.step();
+        if h.state().worker.is_idle() && !h.state().is_loading() {
+            h.step();
+            return;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "render did not finish");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+fn depth_t_index() -> usize {
+    tracelab::gui::lecture::FIGURES.iter().position(|f| f.file == "depth_t.txt").expect("in the menu")
+}
+
+#[test]
+fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
+    let mut h = harness((48, 48));
+    settle(&mut h);
+    h.get_by_label("Lecture").click();
+    for _ in 0..3 {
+        h.step();
+    }
+    h.get_by_label("What to do about the depth t").click();
+    settle(&mut h);
+    let app = h.state();
+    assert!(app.doc.path.as_ref().is_some_and(|p| p.ends_with("depth_t.txt")), "{:?}", app.doc.path);
+    assert_eq!(app.view.object_rays, ObjectRays::NormalizedNoRescale);
+    assert_eq!(app.lecture, Some(depth_t_index()));
+    let _ = h.get_by_label_contains("the big blue sphere jumps in front");
+    // The render on screen uses the rule: the centre pixel, the small red sphere in truth,
+    // shows the big blue one.
+    let centre = h.state().worker.with_published(|p| {
+        let p = p.expect("published");
+        assert_eq!(p.job.settings.object_rays, ObjectRays::NormalizedNoRescale);
+        let f = p.frames[0].lock();
+        f.get(28, 23).expect("pixel").color
+    });
+    assert!(centre[2] > centre[0], "blue in front under the bug: {centre:?}");
+    // The toolbar's switch back to the lecture's rule: red in front again.
+    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    settle(&mut h);
+    let centre = h.state().worker.with_published(|p| p.expect("published").frames[0].lock().get(28, 23).expect("pixel").color);
+    assert!(centre[0] > centre[2], "red in front: {centre:?}");
+    // Opening another file drops the caption.
+    h.state_mut().queue(AppCommand::New);
+    h.step();
+    assert_eq!(h.state().lecture, None);
+}
+
+#[test]
+fn the_ray_panel_draws_both_spaces_for_the_picked_pixel_and_can_be_hidden() {
+    let mut h = harness((48, 48));
+    settle(&mut h);
+    h.state_mut().queue(AppCommand::OpenLecture(depth_t_index()));
+    settle(&mut h);
+    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    settle(&mut h);
+    h.state_mut().inspect(0, 28, 23);
+    for _ in 0..3 {
+        h.step();
+    }
+    let _ = h.get_by_label("World space");
+    let _ = h.get_by_label("Object space (of the primitive hit)");
+    let _ = h.get_by_label_contains("t: world");
+    h.state_mut().queue(AppCommand::ShowRayPanel(false));
+    for _ in 0..2 {
+        h.step();
+    }
+    assert!(h.query_by_label("World space").is_none());
+}
+
+#[test]
+fn an_animation_exported_from_the_editor_writes_every_frame() {
+    let mut h = harness((24, 24));
+    settle(&mut h);
+    h.state_mut().queue(AppCommand::OpenLecture(depth_t_index()));
+    settle(&mut h);
+    let (id, _) = h
+        .state()
+        .doc
+        .scene
+        .graph
+        .iter()
+        .find(|(_, n)| matches!(n.kind, NodeKind::Transform(_)))
+        .expect("a Transform");
+    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.state_mut().queue(AppCommand::AnimationDialog);
+    h.step();
+    assert!(h.state().animation.is_some(), "{:?}", h.state().doc.messages);
+    let dir = std::env::temp_dir().join(format!("tracelab-lecture-gui-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut form = h.state().animation.clone().expect("form");
+    form.frames = 3;
+    form.from = 0.0;
+    form.to = 1.0;
+    form.folder = dir.to_string_lossy().into_owned();
+    h.state_mut().queue(AppCommand::StartAnimation(form));
+    let start = Instant::now();
+    loop {
+        h.step();
+        if h.state().animation_running.is_none() && h.state().doc.messages.iter().any(|m| m.contains("animation") || m.contains("exported")) {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "export did not finish");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let msg = h.state().doc.messages.last().cloned().unwrap_or_default();
+    assert!(msg.starts_with("exported 3 frames"), "{msg}");
+    for f in ["frame_0000.png", "frame_0001.png", "frame_0002.png", "frame.apng.png"] {
+        assert!(PathBuf::from(&dir).join(f).is_file(), "{f}");
+    }
+    // Without a Transform selected the dialog is refused with a reason.
+    h.state_mut().doc.select(None);
+    h.state_mut().animation = None;
+    h.state_mut().queue(AppCommand::AnimationDialog);
+    h.step();
+    assert!(h.state().animation.is_none());
+    assert!(h.state().doc.messages.iter().any(|m| m.contains("select a Transform first")));
+}
