@@ -163,6 +163,17 @@ pub fn box_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<(f32, u32, f32, u32)>
     (near < far).then_some((near, near_face, far, far_face))
 }
 
+/// The box around a sphere (a negative radius is a sphere of its absolute size).
+pub fn sphere_bounds(center: Vec3, radius: f32) -> super::Aabb {
+    super::Aabb::new(center - Vec3::splat(radius.abs()), center + Vec3::splat(radius.abs()))
+}
+
+/// A sphere's outward normal at `p` (Z where `p` is its centre).
+#[inline]
+pub fn sphere_normal(center: Vec3, p: Vec3) -> Vec3 {
+    (p - center).normalize_or(Vec3::Z)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,7 +13,7 @@ use super::NormalTransform;
 use crate::accel::Bvh;
 use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere, intersect_triangle,
-    triangle_normal,
+    sphere_bounds, sphere_normal, triangle_normal,
 };
 use crate::scene::validate::compose_f64;
 use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
@@ -270,7 +270,7 @@ impl CompiledScene {
                     Some(xf) => ray.transformed(&xf.object_from_world),
                     None => *ray,
                 };
-                (r.at(hit.t) - *center).normalize_or(Vec3::Z)
+                sphere_normal(*center, r.at(hit.t))
             }
             Shape::Plane { normal, .. } => *normal,
             Shape::Triangle { normal, .. } => *normal,
@@ -287,13 +287,7 @@ impl CompiledScene {
             return tree.world_normal(ray, hit.t, hit.prim, mode);
         }
         let n = self.object_normal(ray, hit);
-        match self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()) {
-            None => n,
-            Some(xf) => match mode {
-                NormalTransform::Correct => (xf.normal_from_object * n).normalize_or(n),
-                NormalTransform::Incorrect => xf.world_from_object.transform_vector3(n).normalize_or(n),
-            },
-        }
+        mode.apply(self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()), n)
     }
 
     pub fn object_count(&self) -> usize {
@@ -366,7 +360,7 @@ pub(super) fn shape_hit(shape: &Shape, r: &Ray, t_min: f32, t_max: f32) -> Optio
 
 fn object_bounds(o: &Object) -> Aabb {
     let local = match &o.shape {
-        Shape::Sphere { center, radius } => Aabb::new(*center - Vec3::splat(radius.abs()), *center + Vec3::splat(radius.abs())),
+        Shape::Sphere { center, radius } => sphere_bounds(*center, *radius),
         Shape::Plane { .. } => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
         Shape::Triangle { vertices, .. } => Aabb::from_points(vertices),
         Shape::Mesh(m) => m.bounds(),
@@ -374,8 +368,5 @@ fn object_bounds(o: &Object) -> Aabb {
         // Already in world space (the object has no transform of its own).
         Shape::Csg(tree) => return tree.bounds(),
     };
-    match &o.xf {
-        Some(xf) if local.is_finite() => local.transformed(&xf.world_from_object),
-        _ => local,
-    }
+    o.xf.as_ref().map_or(local, |xf| xf.world_bounds(local))
 }

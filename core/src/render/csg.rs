@@ -13,7 +13,7 @@ use glam::{DMat4, Vec3};
 
 use super::NormalTransform;
 use crate::accel::TriangleHit;
-use crate::geometry::{Aabb, Ray, Transform, box_face_normal, box_span, sphere_roots};
+use crate::geometry::{Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots};
 use crate::scene::validate::compose_f64;
 use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
 
@@ -244,12 +244,7 @@ impl CsgTree {
     /// `object_normal` is: the flip commutes with either linear map).
     pub fn world_normal(&self, ray: &Ray, t: f32, code: u32, mode: NormalTransform) -> Vec3 {
         let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
-        let n = self.object_normal(ray, t, code);
-        match (&leaf.xf, mode) {
-            (None, _) => n,
-            (Some(xf), NormalTransform::Correct) => (xf.normal_from_object * n).normalize_or(n),
-            (Some(xf), NormalTransform::Incorrect) => xf.world_from_object.transform_vector3(n).normalize_or(n),
-        }
+        mode.apply(leaf.xf.as_ref(), self.object_normal(ray, t, code))
     }
 
     pub fn leaf(&self, code: u32) -> Option<&CsgLeaf> {
@@ -280,18 +275,13 @@ fn program_bounds(program: &[Step], leaves: &[CsgLeaf]) -> Aabb {
 
 fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
     let local = match &leaf.solid {
-        Solid::Sphere { center, radius } => {
-            Aabb::new(*center - Vec3::splat(radius.abs()), *center + Vec3::splat(radius.abs()))
-        }
+        Solid::Sphere { center, radius } => sphere_bounds(*center, *radius),
         Solid::Box { min, max } => Aabb::new(*min, *max),
         Solid::HalfSpace { .. } => return Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
         Solid::Mesh(m) => m.bounds(),
         Solid::Empty => return Aabb::EMPTY,
     };
-    match &leaf.xf {
-        Some(xf) => local.transformed(&xf.world_from_object),
-        None => local,
-    }
+    leaf.xf.as_ref().map_or(local, |xf| xf.world_bounds(local))
 }
 
 /// Appends a leaf's sorted boundaries along the whole (object-space) ray.
@@ -363,7 +353,7 @@ fn leaf_bounds(solid: &Solid, r: &Ray, leaf: u32, out: &mut Vec<Bound>, hits: &m
 /// The object-space outward normal of a leaf at the boundary the ray crosses at t.
 fn leaf_normal(solid: &Solid, r: &Ray, t: f32, exit: bool) -> Vec3 {
     match solid {
-        Solid::Sphere { center, .. } => (r.at(t) - *center).normalize_or(Vec3::Z),
+        Solid::Sphere { center, .. } => sphere_normal(*center, r.at(t)),
         Solid::Box { min, max } => match box_span(r, *min, *max) {
             Some((_, f_in, _, f_out)) => box_face_normal(if exit { f_out } else { f_in }),
             None => Vec3::Z,

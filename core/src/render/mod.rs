@@ -38,6 +38,19 @@ pub enum NormalTransform {
     Incorrect,
 }
 
+impl NormalTransform {
+    /// An object-space normal in world space by this rule, normalised; `None` (no transform)
+    /// leaves it as it is. The one place the lecture's two rules are written.
+    #[inline]
+    pub fn apply(self, xf: Option<&crate::geometry::Transform>, n: glam::Vec3) -> glam::Vec3 {
+        match (xf, self) {
+            (None, _) => n,
+            (Some(xf), NormalTransform::Correct) => xf.normal_by_inverse_transpose(n),
+            (Some(xf), NormalTransform::Incorrect) => xf.normal_by_m(n),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
