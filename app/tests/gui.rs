@@ -13,6 +13,7 @@ use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
 
 
 mod common;
+use common::settle;
 
 fn repo(rel: &str) -> PathBuf {
     common::repo().join(rel)
@@ -45,24 +46,6 @@ fn harness(scene: Option<PathBuf>, size: (u32, u32)) -> Harness<'static, Tracela
                 },
             )
         })
-}
-
-/// Steps the UI until the scene is read and the renderer has finished the newest request.
-fn settle(h: &mut Harness<'static, TracelabApp>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().worker.is_idle() && !h.state().is_loading() {
-            // One more frame uploads the last pixels.
-            h.step();
-            return;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "render did not finish"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 /// The first Transform in the scene whose first op is a Translate.

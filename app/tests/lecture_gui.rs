@@ -1,6 +1,8 @@
 //! The editor's teaching views (issue 14) driven as a user would, with egui_kittest: the
 //! Lecture menu, the depth-t switch, the Ray panel and the animation export. No GPU needed.
 
+mod common;
+use common::settle;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -16,19 +18,6 @@ fn harness(size: (u32, u32)) -> Harness<'static, TracelabApp> {
         .with_size(egui::vec2(1200.0, 760.0))
         .with_max_steps(10_000)
         .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: None, fixed_size: Some(size), ..AppOptions::default() }))
-}
-
-fn settle(h: &mut Harness<'static, TracelabApp>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().worker.is_idle() && !h.state().is_loading() {
-            h.step();
-            return;
-        }
-        assert!(start.elapsed() < Duration::from_secs(60), "render did not finish");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 fn depth_t_index() -> usize {

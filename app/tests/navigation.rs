@@ -2,6 +2,8 @@
 //! orbit, zoom, framing, the axis views and the gizmo's handles, with egui_kittest. Every
 //! check is on the document (the course's camera and Transform ops) or on the pixels shown.
 
+mod common;
+use common::settle;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -44,19 +46,6 @@ fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
         .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(SIZE), ..AppOptions::default() }));
     settle(&mut h);
     h
-}
-
-fn settle(h: &mut Harness<'static, TracelabApp>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().worker.is_idle() && !h.state().is_loading() {
-            h.step();
-            return;
-        }
-        assert!(start.elapsed() < Duration::from_secs(60), "render did not finish");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 fn camera(h: &Harness<'static, TracelabApp>) -> Camera {

@@ -2,8 +2,9 @@
 //! viewport's `shown()`: the textures as uploaded) against the command line's render of the
 //! same settings. Deterministic: each check waits for the render worker to be idle.
 
+mod common;
+use common::settle;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -44,21 +45,6 @@ fn harness(scene: &Path, size: (u32, u32)) -> Harness<'static, TracelabApp> {
         .with_size(egui::vec2(1200.0, 760.0))
         .with_max_steps(10_000)
         .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(size), ..AppOptions::default() }))
-}
-
-/// Steps until the scene is loaded and the renderer has finished the newest request, then
-/// once more so the last pixels are uploaded and drawn.
-fn settle(h: &mut Harness<'static, TracelabApp>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().worker.is_idle() && !h.state().is_loading() {
-            h.step();
-            return;
-        }
-        assert!(start.elapsed() < Duration::from_secs(60), "render did not finish");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 fn click(h: &mut Harness<'static, TracelabApp>, label: &str) {

@@ -35,23 +35,15 @@ pub struct ViewBasis {
 
 impl ViewBasis {
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let (center, dir, up, extent, perspective) = match *camera {
-            Camera::Orthographic { center, direction, up, size } => (center, direction, up, size, false),
-            Camera::Perspective { center, direction, up, angle } => {
-                (center, direction, up, 2.0 * (angle.to_radians() * 0.5).tan(), true)
-            }
-        };
-        // Exactly core's `CameraRays::new`, so what is drawn over the image lines up with it.
-        let direction = unit(dir).unwrap_or(Vec3::NEG_Z);
-        let horizontal = direction.cross(unit(up).unwrap_or(Vec3::Y)).normalize_or(Vec3::X);
-        let up = horizontal.cross(direction);
+        // Core's own camera basis, so what is drawn over the image lines up with its rays.
+        let c = tracelab_core::render::CameraRays::new(camera);
         ViewBasis {
-            center,
-            direction,
-            horizontal,
-            up,
-            extent,
-            perspective,
+            center: c.center,
+            direction: c.direction,
+            horizontal: c.horizontal,
+            up: c.up,
+            extent: c.extent,
+            perspective: c.perspective,
             width: width.max(1) as f32,
             height: height.max(1) as f32,
         }

@@ -17,3 +17,18 @@ pub fn temp_dir(area: &str, name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).expect("temp dir");
     d
 }
+
+/// Steps the UI until the scene is read and the renderer has finished the newest request,
+/// then once more so the last pixels are uploaded and drawn.
+pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>) {
+    let start = std::time::Instant::now();
+    loop {
+        h.step();
+        if h.state().worker.is_idle() && !h.state().is_loading() {
+            h.step();
+            return;
+        }
+        assert!(start.elapsed() < std::time::Duration::from_secs(60), "render did not finish");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}

@@ -9,13 +9,15 @@ use crate::scene::{Camera, unit};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRays {
-    center: Vec3,
-    direction: Vec3,
-    horizontal: Vec3,
-    up: Vec3,
+    pub center: Vec3,
+    /// Unit view direction.
+    pub direction: Vec3,
+    /// Unit screen right and up (up made perpendicular to the direction).
+    pub horizontal: Vec3,
+    pub up: Vec3,
     /// Orthographic: full size of the screen. Perspective: 2·tan(angle/2).
-    extent: f32,
-    perspective: bool,
+    pub extent: f32,
+    pub perspective: bool,
 }
 
 impl CameraRays {
