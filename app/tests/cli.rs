@@ -28,6 +28,12 @@ fn help_lists_subcommands_and_succeeds() {
         assert!(out.contains(word), "--help should mention {word}:\n{out}");
     }
     assert!(tracelab(&["render", "--help"], &repo()).status.success());
+    // One line per subcommand, saying what that one does (a merge once gave `animate`
+    // inspect's summary and printed inspect's whole long help in the list).
+    let line = |cmd: &str| out.lines().find(|l| l.trim_start().starts_with(&format!("{cmd} "))).unwrap_or_default().to_string();
+    assert!(line("animate").contains("Sweep") && !line("animate").contains("pixel"), "{out}");
+    assert!(line("inspect").contains("pixel's story"), "{out}");
+    assert!(!out.contains("Pixels are counted as images store them"), "the list shows short help only:\n{out}");
 }
 
 #[test]

@@ -49,12 +49,12 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
     Render(RenderArgs),
-    /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).
     /// Sweep one number of a Transform op over N frames: a PNG sequence and an animated PNG.
     Animate(animate::AnimateArgs),
     /// Compare your image with the reference for a course command line (after --): heat map, worst pixels.
     #[command(long_about = diff::LONG_ABOUT)]
     Diff(diff::DiffArgs),
+    /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).
     #[command(long_about = inspect::LONG_ABOUT)]
     Inspect(inspect::InspectArgs),
     /// Rewrite a scene file in canonical form.
