@@ -112,8 +112,13 @@ fn trace_packets(
     let t_min = scene.camera.t_min();
     for chunk in px.chunks(8) {
         let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
+        // A packet spans two rows: each row's share of the rays once.
+        let mut row_rays = (u32::MAX, rays.row(chunk[0].1));
         for (k, &(x, row)) in chunk.iter().enumerate() {
-            r[k] = rays.row(row).ray(x);
+            if row != row_rays.0 {
+                row_rays = (row, rays.row(row));
+            }
+            r[k] = row_rays.1.ray(x);
         }
         let active = ((1u16 << chunk.len()) - 1) as u8;
         let hits = scene.intersect8(&r, active, t_min, f32::INFINITY);
@@ -207,8 +212,10 @@ fn pixels_to_trace(
     scale: u32,
     traced_before: impl Fn(u32, u32) -> bool,
 ) -> Vec<(u32, u32)> {
-    let mut px = Vec::new();
     let step = scale as usize;
+    // At most the tile's grid points: no growing while filling.
+    let cap = ((x1 - x0) as usize).div_ceil(step) * ((y1 - y0) as usize).div_ceil(step);
+    let mut px = Vec::with_capacity(cap);
     for row in (y0..y1).step_by(2 * step) {
         for x in (x0..x1).step_by(4 * step) {
             for r in [row, row + scale] {
@@ -262,7 +269,8 @@ fn render_scales(
             let y0 = ty * TILE;
             let x1 = (x0 + TILE).min(w);
             let y1 = (y0 + TILE).min(h);
-            let mut local: Vec<(u32, u32, Sample)> = Vec::new();
+            let grid = ((x1 - x0) as usize).div_ceil(scale as usize) * ((y1 - y0) as usize).div_ceil(scale as usize);
+            let mut local: Vec<(u32, u32, Sample)> = Vec::with_capacity(grid);
             let traced_before = |x: u32, row: u32| coarser.is_some_and(|c| x % c == 0 && row % c == 0);
             match tracing {
                 // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
