@@ -155,7 +155,7 @@ fn the_depth_range_maps_depth_as_the_command_line_does() {
     settle(&mut h);
     click(&mut h, "Depth");
     let before = single(&h).rgb8();
-    h.get_by_label("min").set_value_accesskit(9.0);
+    h.get_by_label("depth min").set_value_accesskit(9.0);
     h.step();
     h.get_by_label("max").set_value_accesskit(10.5);
     h.step();

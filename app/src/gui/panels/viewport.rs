@@ -207,11 +207,13 @@ impl Viewport {
                     "Incorrect M",
                 );
             });
-            match gap {
-                Some(g) if g.degrees == 0.0 => ui.label("0° apart: all similitudes"),
-                Some(g) => ui.label(format!("up to {:.2}° apart", g.degrees)),
-                None => ui.label("…"),
-            }
+            // Never broken over two rows of the bar.
+            let gap_text = match gap {
+                Some(g) if g.degrees == 0.0 => "0° apart: all similitudes".to_string(),
+                Some(g) => format!("up to {:.2}° apart", g.degrees),
+                None => "…".to_string(),
+            };
+            ui.add(egui::Label::new(gap_text).extend())
             .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels (0 exactly when every transform on screen is a similitude)");
             ui.separator();
             egui::ComboBox::from_label("compare")
@@ -245,17 +247,9 @@ impl Viewport {
             ui.separator();
             ui.checkbox(&mut s.shade_back, "shade back");
             ui.separator();
-            ui.label("depth");
-            ui.add(
-                egui::DragValue::new(&mut s.depth.0)
-                    .speed(0.05)
-                    .prefix("min "),
-            );
-            ui.add(
-                egui::DragValue::new(&mut s.depth.1)
-                    .speed(0.05)
-                    .prefix("max "),
-            );
+            // "depth" inside the first value, so no lone label ends a row of the bar.
+            ui.add(egui::DragValue::new(&mut s.depth.0).speed(0.05).prefix("depth min "));
+            ui.add(egui::DragValue::new(&mut s.depth.1).speed(0.05).prefix("max "));
             ui.separator();
             let mut fixed = s.fixed_size.is_some();
             if ui.checkbox(&mut fixed, "fixed size").changed() {
