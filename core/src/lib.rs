@@ -7,6 +7,7 @@ pub mod format;
 pub mod geometry;
 pub mod render;
 pub mod scene;
+pub mod simd;
 
 pub use format::{
     Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, load_scene_unresolved, parse_scene,

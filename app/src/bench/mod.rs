@@ -52,6 +52,10 @@ pub struct ProgressiveArgs {
     /// for bit; to measure what the packets gain).
     #[arg(long)]
     pub single_rays: bool,
+    /// Time one full-resolution pass (what `tracelab render` does) instead of the coarse
+    /// passes and the full one: what the progressive passes cost on top.
+    #[arg(long)]
+    pub one_pass: bool,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use tracelab_core::render::SharedFrame;
 use glam::Vec3;
 use tracelab_core::render::render_coarse;
-use tracelab_core::render::{Tracing, render_progressive_traced};
+use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
 use tracelab_core::{CompiledScene, RenderSettings, Scene, render_progressive};
 
 use crate::gui::bounds::world_bounds;
@@ -32,6 +32,11 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         let compiled = CompiledScene::new(&scene);
         let mut coarse = None;
         let mut full = Duration::ZERO;
+        if b.one_pass {
+            std::hint::black_box(render_frame_traced(&compiled, &settings, tracing));
+            let t = start.elapsed().as_secs_f64() * 1e3;
+            return (t, t);
+        }
         let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |_| {
             coarse.get_or_insert(start.elapsed());
             full = start.elapsed();
@@ -46,9 +51,10 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
     out!(
-        "frame: {w}x{h}, {} threads, medians of {}, primary rays {}",
+        "frame: {w}x{h}, {} threads, medians of {}, {}, primary rays {}",
         rayon::current_num_threads(),
         runs.len(),
+        if b.one_pass { "one full-resolution pass" } else { "coarse passes, then the full one" },
         if b.single_rays { "one at a time" } else { "in packets of 8" }
     );
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");

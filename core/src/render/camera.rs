@@ -69,7 +69,13 @@ impl CameraRays {
                 if self.perspective { self.direction + sx * self.horizontal } else { self.center + sx * self.horizontal }
             })
             .collect();
-        PixelRays { camera: *self, columns, width, height }
+        let rows = (0..height)
+            .map(|row| {
+                let (_, y) = screen_point(0, row, width, height);
+                ((y - 0.5) * self.extent) * self.up
+            })
+            .collect();
+        PixelRays { camera: *self, columns, rows }
     }
 }
 
@@ -80,8 +86,8 @@ pub struct PixelRays {
     camera: CameraRays,
     /// Perspective: direction + sx·horizontal; orthographic: centre + sx·horizontal.
     columns: Vec<Vec3>,
-    width: u32,
-    height: u32,
+    /// sy·up of each row (counted from the top).
+    rows: Vec<Vec3>,
 }
 
 /// One row's share of `PixelRays`: sy·up.
@@ -96,9 +102,8 @@ impl PixelRays {
     /// The rays of row `row` (counted from the top).
     #[inline]
     pub fn row(&self, row: u32) -> RowRays<'_> {
-        let (_, y) = screen_point(0, row, self.width, self.height);
-        let sy = (y - 0.5) * self.camera.extent;
-        RowRays { camera: &self.camera, columns: &self.columns, sy_up: sy * self.camera.up }
+        let sy_up = self.rows.get(row as usize).or(self.rows.last()).copied().unwrap_or(Vec3::ZERO);
+        RowRays { camera: &self.camera, columns: &self.columns, sy_up }
     }
 }
 

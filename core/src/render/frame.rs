@@ -96,11 +96,13 @@ impl Frame {
     }
 }
 
-pub(super) fn sample_from(color: Vec3, normal: Vec3, t: f32, node: u32) -> Sample {
-    Sample {
-        color: [quantize(color.x), quantize(color.y), quantize(color.z)],
-        normal: [quantize(normal.x.abs()), quantize(normal.y.abs()), quantize(normal.z.abs())],
-        t,
-        node,
-    }
+/// Stores a pixel's results into `dst` field by field. Built whole and then copied, the
+/// sample went through the stack: its narrow stores (the byte arrays) read back as one 16-byte
+/// load, a failed store forward costing about a quarter of a frame's time (docs/perf.md).
+#[inline(always)]
+pub(super) fn write_sample(dst: &mut Sample, color: Vec3, normal: Vec3, t: f32, node: u32) {
+    dst.color = [quantize(color.x), quantize(color.y), quantize(color.z)];
+    dst.normal = [quantize(normal.x.abs()), quantize(normal.y.abs()), quantize(normal.z.abs())];
+    dst.t = t;
+    dst.node = node;
 }

@@ -11,6 +11,7 @@ mod object_rays;
 mod progressive;
 mod rule_gap;
 mod shade;
+mod shade_lanes;
 mod similitude;
 
 pub use camera::CameraRays;

@@ -10,9 +10,11 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use super::camera::PixelRays;
 use super::compile::CompiledScene;
-use super::frame::{Frame, Sample, sample_from};
+use super::frame::{Frame, Sample, write_sample};
 use super::shade::shade_fast;
+use super::shade_lanes::shade_packet;
 use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
@@ -88,60 +90,101 @@ pub enum Tracing {
     SingleRays,
 }
 
-/// Traces one pixel's ray and shades it.
+/// Traces one pixel's ray and shades it into `dst`.
 #[inline]
-fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray) -> Sample {
+fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut Sample) {
     // The default rule stays on the fast path, exactly as before the other rules existed.
     let hit = if s.object_rays == ObjectRays::Unnormalized {
         scene.intersect(&ray, scene.camera.t_min(), f32::INFINITY)
     } else {
         scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
     };
-    shade_sample(scene, s, &ray, hit)
+    let shaded = hit.as_ref().map_or((glam::Vec3::ZERO, glam::Vec3::ZERO), |h| shade_fast(scene, &ray, h, s));
+    store_sample(scene, dst, hit.as_ref(), shaded);
 }
 
-/// Appends the samples of `px` (one tile's pixels to trace, in the order `pixels_to_trace`
-/// gives them: 4×2 neighbourhoods), eight rays at a time.
-fn trace_packets(
-    scene: &CompiledScene,
-    s: &RenderSettings,
-    rays: &super::camera::PixelRays,
-    px: &[(u32, u32)],
-    out: &mut Vec<(u32, u32, Sample)>,
-) {
+/// Traces the grid points `pts` (grid coordinates of one tile's pass, in the order
+/// `points_to_trace` gives them: 4×2 neighbourhoods) eight rays at a time, storing each sample
+/// at its place in `grid` (row-major, `gw` points a row).
+fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, rays: &PixelRays, pts: &[(u32, u32)], grid: &mut [Sample]) {
     let t_min = scene.camera.t_min();
-    for chunk in px.chunks(8) {
+    for chunk in pts.chunks(8) {
         let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
-        // A packet spans two rows: each row's share of the rays once.
-        let mut row_rays = (u32::MAX, rays.row(chunk[0].1));
-        for (k, &(x, row)) in chunk.iter().enumerate() {
-            if row != row_rays.0 {
-                row_rays = (row, rays.row(row));
-            }
-            r[k] = row_rays.1.ray(x);
+        for (k, &(i, j)) in chunk.iter().enumerate() {
+            let (x, row) = pass.pixel(i, j);
+            r[k] = rays.row(row).ray(x);
         }
         let active = ((1u16 << chunk.len()) - 1) as u8;
         let hits = scene.intersect8(&r, active, t_min, f32::INFINITY);
-        for (k, &(x, row)) in chunk.iter().enumerate() {
-            out.push((x, row, shade_sample(scene, s, &r[k], hits[k])));
+        let shaded = shade_packet(scene, &r, &hits, s);
+        for (k, &(i, j)) in chunk.iter().enumerate() {
+            store_sample(scene, &mut grid[pass.index(i, j)], hits[k].as_ref(), shaded[k]);
         }
     }
 }
 
-#[inline]
-fn shade_sample(scene: &CompiledScene, s: &RenderSettings, ray: &Ray, hit: Option<super::compile::Hit>) -> Sample {
+/// One pass over one tile: the grid of every `scale`-th pixel from the tile's corner, of
+/// which the points of the coarser pass before (every `ratio`-th point of this grid, or none)
+/// are already in the frame.
+#[derive(Clone, Copy, Debug)]
+struct TilePass {
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+    scale: u32,
+    /// Grid points per row and rows.
+    gw: u32,
+    gh: u32,
+    /// The coarser pass's step in this grid's points, a power of two (0: no coarser pass).
+    ratio: u32,
+}
+
+impl TilePass {
+    fn new((x0, y0, x1, y1): (u32, u32, u32, u32), scale: u32, coarser: Option<u32>) -> Self {
+        let ratio = coarser.map_or(0, |c| c / scale);
+        // Tile corners are multiples of every scale, so the coarser grid is every ratio-th
+        // point of this one; `traced_before` tests that with a mask, no division per pixel.
+        debug_assert!(coarser.is_none_or(|c| c % scale == 0 && ratio.is_power_of_two()));
+        debug_assert!(x0 % TILE == 0 && y0 % TILE == 0 && TILE % scale == 0);
+        TilePass {
+            x0,
+            y0,
+            x1,
+            y1,
+            scale,
+            gw: (x1 - x0).div_ceil(scale),
+            gh: (y1 - y0).div_ceil(scale),
+            ratio,
+        }
+    }
+    #[inline]
+    fn traced_before(&self, i: u32, j: u32) -> bool {
+        self.ratio != 0 && (i | j) & (self.ratio - 1) == 0
+    }
+    #[inline]
+    fn pixel(&self, i: u32, j: u32) -> (u32, u32) {
+        (self.x0 + i * self.scale, self.y0 + j * self.scale)
+    }
+    #[inline]
+    fn index(&self, i: u32, j: u32) -> usize {
+        (j * self.gw + i) as usize
+    }
+    fn points(&self) -> usize {
+        (self.gw * self.gh) as usize
+    }
+}
+
+/// Stores a pixel's sample, hit or miss, into `dst`.
+#[inline(always)]
+fn store_sample(scene: &CompiledScene, dst: &mut Sample, hit: Option<&super::compile::Hit>, (c, n): (glam::Vec3, glam::Vec3)) {
     match hit {
         Some(hit) => {
-            let (c, n) = shade_fast(scene, ray, &hit, s);
             // The operand, for a CSG surface: what the pixel inspector and picking show.
-            let node = scene.hit_node(&hit).map_or(u32::MAX, |n| n.0);
-            sample_from(c, n, hit.t, node)
+            let node = scene.hit_node(hit).map_or(u32::MAX, |n| n.0);
+            write_sample(dst, c, n, hit.t, node);
         }
-        None => {
-            let mut m = sample_from(scene.background, glam::Vec3::ZERO, f32::INFINITY, u32::MAX);
-            m.normal = [0; 3];
-            m
-        }
+        None => write_sample(dst, scene.background, glam::Vec3::ZERO, f32::INFINITY, u32::MAX),
     }
 }
 
@@ -205,30 +248,48 @@ pub fn render_full(
     render_scales(scene, settings, target, cancel, &[1], Tracing::default(), &mut |_| {})
 }
 
-/// The pixels of a tile that a pass of `scale` traces, in 4×2 neighbourhoods of its grid (two
-/// rows, four columns at a time), so that eight consecutive ones make a coherent packet.
-fn pixels_to_trace(
-    (x0, y0, x1, y1): (u32, u32, u32, u32),
-    scale: u32,
-    traced_before: impl Fn(u32, u32) -> bool,
-) -> Vec<(u32, u32)> {
-    let step = scale as usize;
-    // At most the tile's grid points: no growing while filling.
-    let cap = ((x1 - x0) as usize).div_ceil(step) * ((y1 - y0) as usize).div_ceil(step);
-    let mut px = Vec::with_capacity(cap);
-    for row in (y0..y1).step_by(2 * step) {
-        for x in (x0..x1).step_by(4 * step) {
-            for r in [row, row + scale] {
-                for k in 0..4 {
-                    let xx = x + k * scale;
-                    if r < y1 && xx < x1 && !traced_before(xx, r) {
-                        px.push((xx, r));
+/// The grid points of a tile's pass not traced before, in 4×2 neighbourhoods (two rows, four
+/// columns at a time), so that eight consecutive ones make a coherent packet.
+fn points_to_trace(pass: &TilePass) -> Vec<(u32, u32)> {
+    let mut pts = Vec::with_capacity(pass.points());
+    for j in (0..pass.gh).step_by(2) {
+        for i in (0..pass.gw).step_by(4) {
+            for jj in [j, j + 1] {
+                for ii in i..(i + 4).min(pass.gw) {
+                    if jj < pass.gh && !pass.traced_before(ii, jj) {
+                        pts.push((ii, jj));
                     }
                 }
             }
         }
     }
-    px
+    pts
+}
+
+/// Writes a tile's pass into the frame: every grid point's sample over its scale×scale block.
+/// The points traced before are read back from the frame (their blocks hold them), so each
+/// grid row expands to one pixel row that is then copied to the block's rows.
+fn write_tile(f: &mut Frame, pass: &TilePass, grid: &mut [Sample], line: &mut Vec<Sample>) {
+    let w = f.width as usize;
+    let (x0, x1) = (pass.x0 as usize, pass.x1 as usize);
+    let s = pass.scale as usize;
+    for j in 0..pass.gh {
+        let (_, y) = pass.pixel(0, j);
+        let row = &mut grid[pass.index(0, j)..pass.index(0, j) + pass.gw as usize];
+        if pass.traced_before(0, j) {
+            for i in (0..pass.gw).step_by(pass.ratio as usize) {
+                let (x, _) = pass.pixel(i, j);
+                row[i as usize] = f.samples[y as usize * w + x as usize];
+            }
+        }
+        line.clear();
+        for (i, &sample) in row.iter().enumerate() {
+            line.extend(std::iter::repeat_n(sample, s.min(x1 - x0 - i * s)));
+        }
+        for yy in y as usize..(y + pass.scale).min(pass.y1) as usize {
+            f.samples[yy * w + x0..yy * w + x1].copy_from_slice(line);
+        }
+    }
 }
 
 fn render_scales(
@@ -267,38 +328,26 @@ fn render_scales(
             }
             let x0 = tx * TILE;
             let y0 = ty * TILE;
-            let x1 = (x0 + TILE).min(w);
-            let y1 = (y0 + TILE).min(h);
-            let grid = ((x1 - x0) as usize).div_ceil(scale as usize) * ((y1 - y0) as usize).div_ceil(scale as usize);
-            let mut local: Vec<(u32, u32, Sample)> = Vec::with_capacity(grid);
-            let traced_before = |x: u32, row: u32| coarser.is_some_and(|c| x % c == 0 && row % c == 0);
+            let tp = TilePass::new((x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)), scale, coarser);
+            let mut grid = vec![Sample::UNSET; tp.points()];
             match tracing {
                 // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
                 Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
-                    let px = pixels_to_trace((x0, y0, x1, y1), scale, traced_before);
-                    trace_packets(scene, settings, &rays, &px, &mut local);
+                    trace_packets(scene, settings, &tp, &rays, &points_to_trace(&tp), &mut grid);
                 }
                 _ => {
-                    for row in (y0..y1).step_by(scale as usize) {
-                        let row_rays = rays.row(row);
-                        for x in (x0..x1).step_by(scale as usize) {
-                            if !traced_before(x, row) {
-                                local.push((x, row, trace_sample(scene, settings, row_rays.ray(x))));
+                    for j in 0..tp.gh {
+                        let row_rays = rays.row(tp.pixel(0, j).1);
+                        for i in 0..tp.gw {
+                            if !tp.traced_before(i, j) {
+                                trace_sample(scene, settings, row_rays.ray(tp.pixel(i, j).0), &mut grid[tp.index(i, j)]);
                             }
                         }
                     }
                 }
             }
-            let mut f = target.lock();
-            for (x, row, s) in local {
-                for yy in row..(row + scale).min(h) {
-                    let base = yy as usize * w as usize;
-                    for xx in x..(x + scale).min(w) {
-                        f.samples[base + xx as usize] = s;
-                    }
-                }
-            }
-            drop(f);
+            let mut line = Vec::with_capacity(TILE as usize);
+            write_tile(&mut target.lock(), &tp, &mut grid, &mut line);
             target.tiles_done.fetch_add(1, Ordering::Relaxed);
             target.bump();
             Ok(())

@@ -70,11 +70,18 @@ pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: 
     // The normal at the point really hit, whatever t the depth rule kept.
     let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
     let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);
+    (lit(scene, ray, hit, normal, settings.shade_back), normal)
+}
+
+/// The lecture's diffuse colour at a hit with world normal `normal`: black for a back face
+/// unless `shade_back` turns the normal toward the eye.
+#[inline(always)]
+fn lit(scene: &CompiledScene, ray: &Ray, hit: &Hit, normal: Vec3, shade_back: bool) -> Vec3 {
     let kd = scene.hit_color(hit);
     let mut n = normal;
     if ray.direction.dot(normal) > 0.0 {
-        if !settings.shade_back {
-            return (Vec3::ZERO, normal);
+        if !shade_back {
+            return Vec3::ZERO;
         }
         n = -normal;
     }
@@ -82,5 +89,5 @@ pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: 
     for &(l, color) in &scene.lights {
         c += l.dot(n).max(0.0) * color * kd;
     }
-    (c, normal)
+    c
 }

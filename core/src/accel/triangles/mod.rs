@@ -100,13 +100,11 @@ fn finite_ray(o: Vec3A, d: Vec3A) -> bool {
     o.is_finite() && d.is_finite()
 }
 
-/// Whether the AVX traversal and leaf test run here.
+/// Whether the AVX traversal and leaf test run here (`crate::simd`: the CPU has AVX and
+/// `TRACELAB_SIMD` does not ask for SSE).
 #[inline(always)]
 fn has_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    return std::arch::is_x86_feature_detected!("avx");
-    #[cfg(not(target_arch = "x86_64"))]
-    false
+    crate::simd::level() >= crate::simd::Level::Avx
 }
 
 /// Nine component arrays of this length hold `n` triangles, padded so an 8-lane load at the
