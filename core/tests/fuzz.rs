@@ -252,7 +252,9 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
 
 #[test]
 fn mutated_scenes_never_panic_and_accepted_ones_round_trip() {
-    let seeds = seeds(&["scenes"], "scenes", "txt");
+    // scenes/perf's generated 1,000-instance scene would take a third of the run for a grammar
+    // the small scenes cover.
+    let seeds: Vec<_> = seeds(&["scenes"], "scenes", "txt").into_iter().filter(|(_, b)| b.len() < 64 << 10).collect();
     assert!(seeds.len() >= 20, "only {} seed scenes", seeds.len());
     let n = fuzz_cases(100_000);
     let accepted = std::sync::atomic::AtomicU64::new(0);

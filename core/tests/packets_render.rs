@@ -1,8 +1,9 @@
 //! The renderer's primary rays as packets (`Tracing::Packets`, what every render uses) give
 //! the image single rays give, bit for bit: colour, normal, t and object id of every pixel,
 //! in one full pass and through the progressive passes (whose coarse samples are sparse
-//! packets), on tracelab's scenes and on the course's and perf scenes in ../shared, under
-//! both normal rules and with and without shade_back.
+//! packets), on tracelab's scenes, on the course's and perf scenes in ../shared and on
+//! scenes/perf's 1,000 bunny instances, under both normal rules and with and without
+//! shade_back.
 
 mod common;
 
@@ -79,4 +80,6 @@ fn packets_match_single_rays_on_the_course_and_perf_scenes() {
     for s in &perf {
         check(s, (64, 48));
     }
+    // 1,000 instances of the course's bunny_1k: the top-level BVH walked by packets.
+    check(&common::repo().join("scenes/perf/bunny_instances_1000.txt"), (64, 48));
 }

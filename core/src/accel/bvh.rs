@@ -160,6 +160,84 @@ impl Bvh {
         }
     }
 
+    /// `traverse` for eight rays together (lanes set in `active`), sharing one stack: each
+    /// node's box is tested against every lane still in, near child first by the nearest
+    /// lane's entry. `leaf(prim_id, lanes, t)` gets the lanes whose box test passed and the
+    /// lanes' current closest t, which it lowers for those it hits; a node is entered, or
+    /// left on the stack, only while some lane still meets it before its t. Every lane
+    /// reaches every leaf its own `traverse` could reach with the same t, so a leaf test that
+    /// does not depend on the order of leaves gives the same answer.
+    pub fn traverse8(
+        &self,
+        origin: &[Vec3A; 8],
+        dir: &[Vec3A; 8],
+        active: u8,
+        t_min: f32,
+        t: &mut [f32; 8],
+        mut leaf: impl FnMut(u32, u8, &mut [f32; 8]),
+    ) {
+        if self.nodes.is_empty() || active == 0 {
+            return;
+        }
+        let inv: [Vec3A; 8] = std::array::from_fn(|k| dir[k].recip());
+        // The lanes meeting node `n` before their t, and the nearest entry among them.
+        let test = |n: u32, lanes: u8, t: &[f32; 8]| -> (u8, f32) {
+            let node = &self.nodes[n as usize];
+            let (lo, hi) = (Vec3A::from(node.min), Vec3A::from(node.max));
+            let mut hit = 0u8;
+            let mut nearest = f32::INFINITY;
+            for k in 0..8 {
+                if lanes & (1 << k) != 0 {
+                    let (near, far) = super::slab::span(lo, hi, origin[k], inv[k], t_min, t[k]);
+                    if near <= far {
+                        hit |= 1 << k;
+                        nearest = nearest.min(near);
+                    }
+                }
+            }
+            (hit, nearest)
+        };
+        let mut stack = [(0u32, 0u8); MAX_DEPTH];
+        let mut sp = 0usize;
+        let (mut lanes, _) = test(0, active, t);
+        let mut idx = 0u32;
+        loop {
+            if lanes != 0 {
+                let node = &self.nodes[idx as usize];
+                if node.is_leaf() {
+                    let first = node.right_or_first as usize;
+                    for &p in self.indices.get(first..first + node.count as usize).unwrap_or(&[]) {
+                        leaf(p, lanes, t);
+                    }
+                } else {
+                    let (l, r) = (idx + 1, node.right_or_first);
+                    let (ml, nl) = test(l, lanes, t);
+                    let (mr, nr) = test(r, lanes, t);
+                    let ((near, mn), (far, mf)) = if nl <= nr { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+                    if mn != 0 && mf != 0 && sp < stack.len() {
+                        stack[sp] = (far, mf);
+                        sp += 1;
+                    }
+                    (idx, lanes) = if mn != 0 { (near, mn) } else { (far, mf) };
+                    continue;
+                }
+            }
+            // Pop, keeping only the lanes that still meet the node with their shrunk t.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (n, m) = stack[sp];
+                let (still, _) = test(n, m, t);
+                if still != 0 {
+                    (idx, lanes) = (n, still);
+                    break;
+                }
+            }
+        }
+    }
+
     /// Checks the structural invariants: every primitive in exactly one leaf, no node deeper
     /// than the traversal stack, children inside their parents' bounds, leaves holding the
     /// boxes of their primitives. For tests.
@@ -304,6 +382,56 @@ mod tests {
         );
         seen.sort_unstable();
         assert_eq!(seen, (0..b.len() as u32).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn traverse8_gives_each_lane_what_traverse_gives_it() {
+        // The boxes themselves as primitives, hit at their entry distance: each lane's final t
+        // must be its single traversal's, whatever subset of lanes is active.
+        let b = boxes(3000);
+        let bvh = Bvh::build(&b);
+        let entry = |p: u32, o: Vec3A, d: Vec3A, t_max: f32| {
+            let (near, far) = crate::accel::slab::span(b[p as usize].min.into(), b[p as usize].max.into(), o, d.recip(), 1e-3, t_max);
+            (near <= far && near < t_max).then_some(near)
+        };
+        let mut s = 0x2545_f491u32;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s as f32 / u32::MAX as f32
+        };
+        let mut hits = 0;
+        for packet in 0..300 {
+            // Coherent packets from one eye, and scattered ones.
+            let eye = Vec3A::new(rnd() * 10.0, rnd() * 10.0, -5.0);
+            let spread = if packet % 3 == 0 { 2.0 } else { 0.05 };
+            let base = Vec3A::new(rnd() - 0.5, rnd() - 0.5, 1.0);
+            let o = [eye; 8];
+            let d: [Vec3A; 8] = std::array::from_fn(|_| base + Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * spread);
+            let active = [0xffu8, 0x5a, 0x81, 0x01][packet % 4];
+            let mut t = [f32::INFINITY; 8];
+            bvh.traverse8(&o, &d, active, 1e-3, &mut t, |p, lanes, t| {
+                for k in 0..8 {
+                    if lanes & (1 << k) != 0 {
+                        assert!(active & (1 << k) != 0, "inactive lane {k} offered a leaf");
+                        if let Some(h) = entry(p, o[k], d[k], t[k]) {
+                            t[k] = h;
+                        }
+                    }
+                }
+            });
+            for k in 0..8 {
+                let want = if active & (1 << k) != 0 {
+                    bvh.traverse(o[k].into(), d[k].into(), 1e-3, f32::INFINITY, |p, t_max| entry(p, o[k], d[k], t_max))
+                } else {
+                    f32::INFINITY
+                };
+                assert_eq!(t[k].to_bits(), want.to_bits(), "packet {packet} lane {k}");
+                hits += want.is_finite() as u32;
+            }
+        }
+        assert!(hits > 300, "{hits} hits");
     }
 
     #[test]

@@ -181,32 +181,82 @@ impl CompiledScene {
     }
 
     /// `intersect` for eight rays at once, for those whose bit is set in `active` (the others
-    /// get None): a one-mesh scene traces them as a packet (`TriangleBvh::closest_hit8`,
-    /// the same t as `intersect` bit for bit), any other scene one by one.
+    /// get None), each with the hit `intersect` gives it: a one-mesh scene traces them as one
+    /// packet (`TriangleBvh::closest_hit8`, the same t bit for bit), any other scene walks the
+    /// top-level BVH once for the eight (`Bvh::traverse8`), meshes among its objects taking
+    /// the lanes that reach them as a packet and other shapes one ray at a time.
     #[inline]
     pub fn intersect8(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
         if let Some(i) = self.single_mesh
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
         {
-            let (org, dir): ([Vec3A; 8], [Vec3A; 8]) = match &o.xf {
-                // Direction deliberately not renormalised, as in `mesh_hit`.
-                Some(xf) => (
-                    std::array::from_fn(|k| xf.object_from_world.transform_point3(rays[k].origin).into()),
-                    std::array::from_fn(|k| xf.object_from_world.transform_vector3(rays[k].direction).into()),
-                ),
-                None => (
-                    std::array::from_fn(|k| rays[k].origin.into()),
-                    std::array::from_fn(|k| rays[k].direction.into()),
-                ),
-            };
+            let (org, dir) = Self::object_rays8(o, rays);
             let mut t = [t_max; 8];
             let hits = m.accel.closest_hit8(&org, &dir, active, t_min, &mut t);
             return hits.map(|h| h.map(|h| Hit { t: h.t, object: i, prim: h.triangle }));
         }
-        std::array::from_fn(|k| {
-            if active & (1 << k) != 0 { self.intersect(&rays[k], t_min, t_max) } else { None }
-        })
+        self.intersect_scene8(rays, active, t_min, t_max)
+    }
+
+    /// Eight rays in a mesh instance's object space, computed exactly as `mesh_hit` does.
+    #[inline(always)]
+    fn object_rays8(o: &Object, rays: &[Ray; 8]) -> ([Vec3A; 8], [Vec3A; 8]) {
+        match &o.xf {
+            // Direction deliberately not renormalised, as in `mesh_hit`.
+            Some(xf) => (
+                std::array::from_fn(|k| xf.object_from_world.transform_point3(rays[k].origin).into()),
+                std::array::from_fn(|k| xf.object_from_world.transform_vector3(rays[k].direction).into()),
+            ),
+            None => (
+                std::array::from_fn(|k| rays[k].origin.into()),
+                std::array::from_fn(|k| rays[k].direction.into()),
+            ),
+        }
+    }
+
+    #[inline(never)]
+    fn intersect_scene8(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
+        let mut best: [Option<Hit>; 8] = [None; 8];
+        let mut t = [t_max; 8];
+        for &i in &self.unbounded {
+            for k in lanes(active) {
+                self.offer(i, &rays[k], t_min, &mut t[k], &mut best[k]);
+            }
+        }
+        let org: [Vec3A; 8] = std::array::from_fn(|k| rays[k].origin.into());
+        let dir: [Vec3A; 8] = std::array::from_fn(|k| rays[k].direction.into());
+        self.bvh.traverse8(&org, &dir, active, t_min, &mut t, |i, reach, t| {
+            let Some(o) = self.objects.get(i as usize) else { return };
+            if let Shape::Mesh(m) = &o.shape
+                && reach.count_ones() > 1
+            {
+                let (org, dir) = Self::object_rays8(o, rays);
+                let mut bound: [f32; 8] = std::array::from_fn(|k| tie_bound(i, t[k], best[k].as_ref()));
+                let hits = m.accel.closest_hit8(&org, &dir, reach, t_min, &mut bound);
+                for k in lanes(reach) {
+                    if let Some(h) = hits[k] {
+                        t[k] = h.t;
+                        best[k] = Some(Hit { t: h.t, object: i, prim: h.triangle });
+                    }
+                }
+            } else {
+                for k in lanes(reach) {
+                    self.offer(i, &rays[k], t_min, &mut t[k], &mut best[k]);
+                }
+            }
+        });
+        best
+    }
+
+    /// Offers object `i` to a ray whose closest hit so far is `best` at `t_best`: it takes
+    /// over if it is nearer, or as near with a lower index (`tie_bound`).
+    #[inline]
+    fn offer(&self, i: u32, ray: &Ray, t_min: f32, t_best: &mut f32, best: &mut Option<Hit>) {
+        if let Some((t, prim)) = self.intersect_object(i, ray, t_min, tie_bound(i, *t_best, best.as_ref())) {
+            *t_best = t;
+            *best = Some(Hit { t, object: i, prim });
+        }
     }
 
     /// A mesh instance's closest hit: the ray to object space (as `Vec3`s, whose components
@@ -229,13 +279,10 @@ impl CompiledScene {
         let mut best: Option<Hit> = None;
         let mut t_best = t_max;
         for &i in &self.unbounded {
-            if let Some((t, prim)) = self.intersect_object(i, ray, t_min, t_best) {
-                t_best = t;
-                best = Some(Hit { t, object: i, prim });
-            }
+            self.offer(i, ray, t_min, &mut t_best, &mut best);
         }
         self.bvh.traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
-            let (t, prim) = self.intersect_object(i, ray, t_min, t_max)?;
+            let (t, prim) = self.intersect_object(i, ray, t_min, tie_bound(i, t_max, best.as_ref()))?;
             best = Some(Hit { t, object: i, prim });
             Some(t)
         });
@@ -356,6 +403,22 @@ pub(super) fn shape_hit(shape: &Shape, r: &Ray, t_min: f32, t_max: f32) -> Optio
         }
         Shape::Csg(tree) => tree.intersect(r, t_min, t_max),
     }
+}
+
+/// The t bound to test object `i` with when the nearest hit so far is `best` at `t_best`: one
+/// ulp past `t_best` when `i` comes before `best`'s object, so that of two hits at the very
+/// same t the lower object index wins, as in the course's Group loop. The rule depends on
+/// neither traversal order nor packet grouping, which is what keeps single rays and packets
+/// on the same hit.
+#[inline(always)]
+pub(super) fn tie_bound(i: u32, t_best: f32, best: Option<&Hit>) -> f32 {
+    if best.is_some_and(|b| i < b.object) { t_best.next_up() } else { t_best }
+}
+
+/// The lanes whose bit is set in `mask`.
+#[inline(always)]
+fn lanes(mask: u8) -> impl Iterator<Item = usize> {
+    (0..8).filter(move |k| mask & (1 << k) != 0)
 }
 
 fn object_bounds(o: &Object) -> Aabb {

@@ -3,7 +3,7 @@
 //! it, once correctly (t rescaled back to world) and once as the classic bug (the
 //! object-space t used as the world depth, so differently scaled objects overtake each other).
 
-use super::compile::{CompiledScene, Hit, shape_hit};
+use super::compile::{CompiledScene, Hit, shape_hit, tie_bound};
 use crate::geometry::Ray;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -62,14 +62,14 @@ impl CompiledScene {
                 let mut best = None;
                 let mut t_best = t_max;
                 for &i in &self.unbounded {
-                    if let Some((t, prim)) = self.intersect_object_with(i, ray, t_min, t_best, rule) {
+                    if let Some((t, prim)) = self.intersect_object_with(i, ray, t_min, tie_bound(i, t_best, best.as_ref()), rule) {
                         t_best = t;
                         best = Some(Hit { t, object: i, prim });
                     }
                 }
                 // World t throughout, so the object boxes may prune as usual.
                 self.bvh.traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
-                    let (t, prim) = self.intersect_object_with(i, ray, t_min, t_max, rule)?;
+                    let (t, prim) = self.intersect_object_with(i, ray, t_min, tie_bound(i, t_max, best.as_ref()), rule)?;
                     best = Some(Hit { t, object: i, prim });
                     Some(t)
                 });
