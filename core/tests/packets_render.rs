@@ -55,6 +55,19 @@ fn txt_files(dir: &Path, prefix: &str) -> Vec<PathBuf> {
     v
 }
 
+/// `.ci/run` runs these tests again with `TRACELAB_SIMD=sse`: make sure that took.
+#[test]
+fn the_kernels_are_the_ones_tracelab_simd_asks_for() {
+    use tracelab_core::simd::{Level, detected, level};
+    let want = match std::env::var("TRACELAB_SIMD").as_deref() {
+        Ok("sse") => Level::Sse,
+        Ok("avx") => Level::Avx.min(detected()),
+        _ => detected(),
+    };
+    eprintln!("kernels in use: {} (the CPU has {})", level().name(), detected().name());
+    assert_eq!(level(), want);
+}
+
 #[test]
 fn packets_match_single_rays_on_tracelab_s_scenes() {
     let scenes = txt_files(&common::repo().join("scenes"), "");

@@ -138,8 +138,9 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
         .sum();
     let mrays = (w as f64 * h as f64) / secs / 1e6;
     out!(
-        "frame: {w}x{h}, {} threads, median {:.3} ms of {}, best {:.3} ms ({:.3} Mrays/s)",
+        "frame: {w}x{h}, {} threads, {} kernels, median {:.3} ms of {}, best {:.3} ms ({:.3} Mrays/s)",
         rayon::current_num_threads(),
+        tracelab_core::simd::level().name(),
         secs * 1e3,
         b.repeat.max(1),
         best * 1e3,

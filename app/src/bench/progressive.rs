@@ -51,8 +51,9 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
     out!(
-        "frame: {w}x{h}, {} threads, medians of {}, {}, primary rays {}",
+        "frame: {w}x{h}, {} threads, {} kernels, medians of {}, {}, primary rays {}",
         rayon::current_num_threads(),
+        tracelab_core::simd::level().name(),
         runs.len(),
         if b.one_pass { "one full-resolution pass" } else { "coarse passes, then the full one" },
         if b.single_rays { "one at a time" } else { "in packets of 8" }
