@@ -2,7 +2,8 @@
 //! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
 //! so the last pass leaves exactly the image a single full pass would. Tiles are rendered in
 //! parallel with rayon and copied into a shared frame that another thread may read at any
-//! time; a cancel flag stops the work within one tile.
+//! time: tile by tile in the fine passes, a whole pass at once in the coarse ones (cheap to
+//! trace, dear to write); a cancel flag stops the work within one tile.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
@@ -108,17 +109,24 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut S
 /// at its place in `grid` (row-major, `gw` points a row).
 fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, rays: &PixelRays, pts: &[(u32, u32)], grid: &mut [Sample]) {
     let t_min = scene.camera.t_min();
+    // Every miss stores the same sample: quantise the background once, not per pixel.
+    let mut miss = Sample::UNSET;
+    store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
     for chunk in pts.chunks(8) {
-        let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
-        for (k, &(i, j)) in chunk.iter().enumerate() {
-            let (x, row) = pass.pixel(i, j);
-            r[k] = rays.row(row).ray(x);
+        let mut pixels = [(0, 0); 8];
+        for (p, &(i, j)) in pixels.iter_mut().zip(chunk) {
+            *p = pass.pixel(i, j);
         }
+        let r = rays.rays8(&pixels[..chunk.len()]);
         let active = ((1u16 << chunk.len()) - 1) as u8;
         let hits = scene.intersect8(&r, active, t_min, f32::INFINITY);
         let shaded = shade_packet(scene, &r, &hits, s);
         for (k, &(i, j)) in chunk.iter().enumerate() {
-            store_sample(scene, &mut grid[pass.index(i, j)], hits[k].as_ref(), shaded[k]);
+            let dst = &mut grid[pass.index(i, j)];
+            match &hits[k] {
+                Some(hit) => store_sample(scene, dst, Some(hit), shaded[k]),
+                None => *dst = miss,
+            }
         }
     }
 }
@@ -266,31 +274,64 @@ fn points_to_trace(pass: &TilePass) -> Vec<(u32, u32)> {
     pts
 }
 
-/// Writes a tile's pass into the frame: every grid point's sample over its scale×scale block.
-/// The points traced before are read back from the frame (their blocks hold them), so each
-/// grid row expands to one pixel row that is then copied to the block's rows.
-fn write_tile(f: &mut Frame, pass: &TilePass, grid: &mut [Sample], line: &mut Vec<Sample>) {
-    let w = f.width as usize;
+/// Writes a tile's pass into `band`, the frame's rows from `band_y0` on (`w` pixels a row):
+/// every grid point's sample over its scale×scale block. The points traced before are read
+/// back from the band (their blocks hold them), so each grid row expands to one pixel row that
+/// is then copied to the block's rows.
+fn write_tile(band: &mut [Sample], w: usize, band_y0: u32, pass: &TilePass, grid: &mut [Sample], line: &mut Vec<Sample>) {
     let (x0, x1) = (pass.x0 as usize, pass.x1 as usize);
     let s = pass.scale as usize;
+    line.resize(x1 - x0, Sample::UNSET);
     for j in 0..pass.gh {
-        let (_, y) = pass.pixel(0, j);
+        let y = (pass.pixel(0, j).1 - band_y0) as usize;
         let row = &mut grid[pass.index(0, j)..pass.index(0, j) + pass.gw as usize];
         if pass.traced_before(0, j) {
             for i in (0..pass.gw).step_by(pass.ratio as usize) {
                 let (x, _) = pass.pixel(i, j);
-                row[i as usize] = f.samples[y as usize * w + x as usize];
+                row[i as usize] = band[y * w + x as usize];
             }
         }
-        line.clear();
-        for (i, &sample) in row.iter().enumerate() {
-            line.extend(std::iter::repeat_n(sample, s.min(x1 - x0 - i * s)));
+        if s == 1 {
+            // Full resolution: the grid row is the pixel row.
+            band[y * w + x0..y * w + x1].copy_from_slice(row);
+            continue;
         }
-        for yy in y as usize..(y + pass.scale).min(pass.y1) as usize {
-            f.samples[yy * w + x0..yy * w + x1].copy_from_slice(line);
+        for (block, &sample) in line.chunks_mut(s).zip(row.iter()) {
+            block.fill(sample);
+        }
+        for yy in y..(y + s).min((pass.y1 - band_y0) as usize) {
+            band[yy * w + x0..yy * w + x1].copy_from_slice(line);
         }
     }
 }
+
+/// Traces one tile's pass into a grid of its samples (the points traced before left unset).
+fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays, tracing: Tracing, tp: &TilePass) -> Vec<Sample> {
+    let mut grid = vec![Sample::UNSET; tp.points()];
+    match tracing {
+        // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
+        Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
+            trace_packets(scene, settings, tp, rays, &points_to_trace(tp), &mut grid);
+        }
+        _ => {
+            for j in 0..tp.gh {
+                let row_rays = rays.row(tp.pixel(0, j).1);
+                for i in 0..tp.gw {
+                    if !tp.traced_before(i, j) {
+                        trace_sample(scene, settings, row_rays.ray(tp.pixel(i, j).0), &mut grid[tp.index(i, j)]);
+                    }
+                }
+            }
+        }
+    }
+    grid
+}
+
+/// Passes this coarse or coarser are traced whole and then written in one go, the bands of
+/// tile rows in parallel: their rays are few, and written tile by tile under the frame's lock
+/// the blocks' copies (the whole frame, for a sixteenth of the rays or less) kept all but one
+/// thread waiting (docs/perf.md).
+const WRITE_WHOLE_FROM_SCALE: u32 = 4;
 
 fn render_scales(
     scene: &CompiledScene,
@@ -322,37 +363,111 @@ fn render_scales(
     target.tiles_total.store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
     for (pass, &scale) in scales.iter().enumerate() {
         let coarser = (pass > 0).then(|| scales[pass - 1]);
-        tiles.par_iter().try_for_each(|&(tx, ty)| {
-            if cancel.load(Ordering::Relaxed) {
-                return Err(Cancelled);
-            }
-            let x0 = tx * TILE;
-            let y0 = ty * TILE;
-            let tp = TilePass::new((x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)), scale, coarser);
-            let mut grid = vec![Sample::UNSET; tp.points()];
-            match tracing {
-                // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
-                Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
-                    trace_packets(scene, settings, &tp, &rays, &points_to_trace(&tp), &mut grid);
-                }
-                _ => {
-                    for j in 0..tp.gh {
-                        let row_rays = rays.row(tp.pixel(0, j).1);
-                        for i in 0..tp.gw {
-                            if !tp.traced_before(i, j) {
-                                trace_sample(scene, settings, row_rays.ray(tp.pixel(i, j).0), &mut grid[tp.index(i, j)]);
-                            }
-                        }
+        let tile_pass = |&(tx, ty): &(u32, u32)| {
+            let (x0, y0) = (tx * TILE, ty * TILE);
+            TilePass::new((x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)), scale, coarser)
+        };
+        if scale >= WRITE_WHOLE_FROM_SCALE {
+            let traced: Vec<(TilePass, Vec<Sample>)> = tiles
+                .par_iter()
+                .map(|t| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return Err(Cancelled);
                     }
-                }
+                    let tp = tile_pass(t);
+                    let grid = trace_tile(scene, settings, &rays, tracing, &tp);
+                    target.tiles_done.fetch_add(1, Ordering::Relaxed);
+                    Ok((tp, grid))
+                })
+                .collect::<Result<_, _>>()?;
+            let mut bands: Vec<Vec<(TilePass, Vec<Sample>)>> = (0..tiles_y).map(|_| Vec::new()).collect();
+            for (tp, grid) in traced {
+                bands[(tp.y0 / TILE) as usize].push((tp, grid));
             }
-            let mut line = Vec::with_capacity(TILE as usize);
-            write_tile(&mut target.lock(), &tp, &mut grid, &mut line);
-            target.tiles_done.fetch_add(1, Ordering::Relaxed);
+            // Held across the parallel write: the jobs under it lock nothing (a render's tiles
+            // written one by one never run alongside its own whole-pass write).
+            let mut f = target.lock();
+            let band_len = (w * TILE) as usize;
+            f.samples.par_chunks_mut(band_len).zip(bands.par_iter_mut()).enumerate().for_each(|(b, (band, tiles))| {
+                let mut line = Vec::with_capacity(TILE as usize);
+                for (tp, grid) in tiles {
+                    write_tile(band, w as usize, b as u32 * TILE, tp, grid, &mut line);
+                }
+            });
+            drop(f);
             target.bump();
-            Ok(())
-        })?;
+        } else {
+            tiles.par_iter().try_for_each(|t| {
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(Cancelled);
+                }
+                let tp = tile_pass(t);
+                let mut grid = trace_tile(scene, settings, &rays, tracing, &tp);
+                let mut line = Vec::with_capacity(TILE as usize);
+                write_tile(&mut target.lock().samples, w as usize, 0, &tp, &mut grid, &mut line);
+                target.tiles_done.fetch_add(1, Ordering::Relaxed);
+                target.bump();
+                Ok(())
+            })?;
+        }
         on_pass(PassInfo { pass, passes: scales.len(), scale, elapsed: start.elapsed() });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{MeshCache, load_scene};
+
+    /// What the viewport shows after each pass: every pixel holds the sample of its block's
+    /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
+    /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
+    /// written whole and those written tile by tile, packets and single rays.
+    #[test]
+    fn each_pass_shows_its_blocks_of_the_full_render() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/nested_transforms.txt");
+        let scene = load_scene(&path, &mut MeshCache::new()).into_result().expect("scene loads").0;
+        let c = CompiledScene::new(&scene);
+        for (w, h) in [(150u32, 97u32), (64, 64), (7, 130)] {
+            let s = RenderSettings::new(w, h);
+            let full = render_frame(&c, &s);
+            assert!(full.samples.iter().any(Sample::is_hit) && full.samples.iter().any(|p| !p.is_hit()), "{w}x{h}");
+            for tracing in [Tracing::Packets, Tracing::SingleRays] {
+                let target = SharedFrame::new();
+                let never = AtomicBool::new(false);
+                let mut shown = Vec::new();
+                render_progressive_traced(&c, &s, &target, &never, tracing, |p| shown.push((p.scale, target.lock().clone())))
+                    .expect("not cancelled");
+                assert_eq!(shown.iter().map(|(s, _)| *s).collect::<Vec<_>>(), SCALES);
+                for (scale, f) in &shown {
+                    for y in 0..h {
+                        for x in 0..w {
+                            let corner = full.get(x - x % scale, y - y % scale);
+                            assert_eq!(f.get(x, y), corner, "{w}x{h} {tracing:?} after the {scale}× pass, pixel ({x}, {y})");
+                        }
+                    }
+                }
+                assert_eq!(target.progress(), 1.0);
+            }
+        }
+    }
+
+    /// A cancel before a pass is written leaves the frame as the last pass left it.
+    #[test]
+    fn a_cancelled_render_stops_without_writing_the_pass() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/perspective_mesh.txt");
+        let scene = load_scene(&path, &mut MeshCache::new()).into_result().expect("scene loads").0;
+        let c = CompiledScene::new(&scene);
+        let s = RenderSettings::new(130, 70);
+        let target = SharedFrame::new();
+        let cancel = AtomicBool::new(false);
+        let mut after_first = None;
+        let r = render_progressive(&c, &s, &target, &cancel, |_| {
+            after_first.get_or_insert_with(|| target.lock().clone());
+            cancel.store(true, Ordering::Relaxed);
+        });
+        assert_eq!(r, Err(Cancelled));
+        assert_eq!(after_first.as_ref(), Some(&*target.lock()));
+    }
 }

@@ -49,6 +49,10 @@ fn shade_packet_with(
     kernel: Kernel,
 ) -> [(Vec3, Vec3); N] {
     let mut out = [(Vec3::ZERO, Vec3::ZERO); N];
+    // A packet that misses everything (the background around a model) needs no lane inputs.
+    if hits.iter().all(Option::is_none) {
+        return out;
+    }
     let mut input = Input::default();
     for k in 0..N {
         let Some(hit) = &hits[k] else { continue };
