@@ -105,28 +105,6 @@ impl PixelRays {
         let sy_up = self.rows.get(row as usize).or(self.rows.last()).copied().unwrap_or(Vec3::ZERO);
         RowRays { camera: &self.camera, columns: &self.columns, sy_up }
     }
-
-    /// The rays through up to eight pixels (x, row), bit for bit `row(row).ray(x)`; lanes past
-    /// `pixels.len()` get lane 0's ray (all eight the centre ray, for none). Gathered first and
-    /// normalised together, the eight square roots and divisions overlap.
-    pub fn rays8(&self, pixels: &[(u32, u32)]) -> [Ray; 8] {
-        let (Some(&first), Some(&last_row)) = (pixels.first(), self.rows.last()) else {
-            return [Ray::new(self.camera.center, self.camera.direction); 8];
-        };
-        let (mut x, mut y, mut z) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
-        for k in 0..8 {
-            let (px, row) = pixels.get(k).copied().unwrap_or(first);
-            let a = self.columns.get(px as usize).copied().unwrap_or(Vec3::ZERO);
-            let b = self.rows.get(row as usize).copied().unwrap_or(last_row);
-            (x[k], y[k], z[k]) = (a.x + b.x, a.y + b.y, a.z + b.z);
-        }
-        if !self.camera.perspective {
-            return std::array::from_fn(|k| Ray::new(Vec3::new(x[k], y[k], z[k]), self.camera.direction));
-        }
-        // `Vec3::normalize`: v · (1 / √((x·x + y·y) + z·z)), the same IEEE operations.
-        let r: [f32; 8] = std::array::from_fn(|k| 1.0 / ((x[k] * x[k]) + (y[k] * y[k]) + (z[k] * z[k])).sqrt());
-        std::array::from_fn(|k| Ray::new(self.camera.center, Vec3::new(x[k] * r[k], y[k] * r[k], z[k] * r[k])))
-    }
 }
 
 impl RowRays<'_> {
@@ -220,17 +198,6 @@ mod tests {
                     for i in 0..w {
                         assert_eq!(r.ray(i), c.pixel_ray(i, row, w, h), "{w}x{h} pixel ({i}, {row})");
                         assert_eq!(filled[i as usize], r.ray(i), "fill, {w}x{h} pixel ({i}, {row})");
-                    }
-                }
-                // Eight at a time, and in partial packets.
-                let pixels: Vec<(u32, u32)> =
-                    (0..h).flat_map(|row| (0..w).map(move |x| (x, row))).collect();
-                for n in [8, 5, 1] {
-                    for chunk in pixels.chunks(n) {
-                        let eight = rays.rays8(chunk);
-                        for (k, &(x, row)) in chunk.iter().enumerate() {
-                            assert_eq!(eight[k], rays.row(row).ray(x), "rays8, {w}x{h} pixel ({x}, {row})");
-                        }
                     }
                 }
             }

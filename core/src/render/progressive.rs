@@ -113,11 +113,11 @@ fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, ray
     let mut miss = Sample::UNSET;
     store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
     for chunk in pts.chunks(8) {
-        let mut pixels = [(0, 0); 8];
-        for (p, &(i, j)) in pixels.iter_mut().zip(chunk) {
-            *p = pass.pixel(i, j);
+        let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
+        for (k, &(i, j)) in chunk.iter().enumerate() {
+            let (x, row) = pass.pixel(i, j);
+            r[k] = rays.row(row).ray(x);
         }
-        let r = rays.rays8(&pixels[..chunk.len()]);
         let active = ((1u16 << chunk.len()) - 1) as u8;
         let hits = scene.intersect8(&r, active, t_min, f32::INFINITY);
         let shaded = shade_packet(scene, &r, &hits, s);
