@@ -135,6 +135,11 @@ fn bench_progressive_reports_coarse_before_full() {
     assert!(last.starts_with("PROGRESSIVE "), "last line: {last:?}");
     let (coarse, full) = (field(last, "coarse_ms"), field(last, "full_ms"));
     assert!(coarse > 0.0 && coarse <= full, "{last}");
+    // Each of the four passes' own time, the first being the coarse image's.
+    let passes = out.lines().find_map(|l| l.strip_prefix("passes: ")).expect("a passes line");
+    let each: Vec<f64> = passes.split(" ms").next().unwrap_or_default().split(" + ").map(|v| v.parse().expect("a number")).collect();
+    assert_eq!(each.len(), 4, "{passes}");
+    assert!(each.iter().all(|&t| t >= 0.0) && (each[0] - coarse).abs() < 0.006, "{passes} / {last}");
 }
 
 #[test]

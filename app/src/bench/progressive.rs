@@ -27,29 +27,31 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
     let tracing = if b.single_rays { Tracing::SingleRays } else { Tracing::Packets };
+    // (first coarse image, full frame, each pass's own time), in ms.
     let once = || {
         let start = Instant::now();
         let compiled = CompiledScene::new(&scene);
-        let mut coarse = None;
-        let mut full = Duration::ZERO;
+        let mut ends = Vec::new();
         if b.one_pass {
             std::hint::black_box(render_frame_traced(&compiled, &settings, tracing));
             let t = start.elapsed().as_secs_f64() * 1e3;
-            return (t, t);
+            return (t, t, vec![t]);
         }
         let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |_| {
-            coarse.get_or_insert(start.elapsed());
-            full = start.elapsed();
+            ends.push(start.elapsed().as_secs_f64() * 1e3);
         });
-        (
-            coarse.unwrap_or(full).as_secs_f64() * 1e3,
-            full.as_secs_f64() * 1e3,
-        )
+        let full = ends.last().copied().unwrap_or_else(|| start.elapsed().as_secs_f64() * 1e3);
+        // The first pass's time counts from the compile, as the coarse image's does.
+        let passes = ends.iter().scan(0.0, |before, &end| Some(end - std::mem::replace(before, end))).collect();
+        (ends.first().copied().unwrap_or(full), full, passes)
     };
     once(); // warm-up
-    let runs: Vec<(f64, f64)> = (0..b.repeat.max(1)).map(|_| once()).collect();
+    let runs: Vec<(f64, f64, Vec<f64>)> = (0..b.repeat.max(1)).map(|_| once()).collect();
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
+    let passes: Vec<String> = (0..runs[0].2.len())
+        .map(|i| format!("{:.2}", median(runs.iter().filter_map(|r| r.2.get(i).copied()).collect())))
+        .collect();
     out!(
         "frame: {w}x{h}, {} threads, {} kernels, medians of {}, {}, primary rays {}",
         rayon::current_num_threads(),
@@ -58,6 +60,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         if b.one_pass { "one full-resolution pass" } else { "coarse passes, then the full one" },
         if b.single_rays { "one at a time" } else { "in packets of 8" }
     );
+    out!("passes: {} ms each (medians; the first from the compile on)", passes.join(" + "));
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
     if let Some(steps) = b.orbit {
         run_orbit(&scene, &settings, steps.max(1))?;
