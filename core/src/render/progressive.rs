@@ -384,8 +384,10 @@ fn render_scales(
             for (tp, grid) in traced {
                 bands[(tp.y0 / TILE) as usize].push((tp, grid));
             }
-            // Held across the parallel write: the jobs under it lock nothing (a render's tiles
-            // written one by one never run alongside its own whole-pass write).
+            // Held across the parallel write (about 1 ms at 800², longer for larger frames; a
+            // reader waits that long). No job under it locks this frame, nor can a stolen one:
+            // a render's tile-by-tile passes never overlap its whole-pass writes, and two
+            // renders never share a frame at once (the editor gives each render fresh ones).
             let mut f = target.lock();
             let band_len = (w * TILE) as usize;
             f.samples.par_chunks_mut(band_len).zip(bands.par_iter_mut()).enumerate().for_each(|(b, (band, tiles))| {
