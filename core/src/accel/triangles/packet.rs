@@ -17,6 +17,21 @@ use crate::accel::wide::WIDTH;
 #[cfg(target_arch = "x86_64")]
 use crate::accel::wide::{self, Child, Node8, RayStack};
 
+/// A sparse packet whose first `INCOHERENT_AFTER_LEAVES` leaves are each entered by fewer
+/// than `INCOHERENT_RAYS_PER_LEAF` of its rays on average is incoherent (rays far apart on a
+/// fine mesh: the dragon's coarse passes) and goes one ray at a time: its box tests, over
+/// bounds of all its rays, enter far more of the tree than any one ray would.
+#[cfg(target_arch = "x86_64")]
+const INCOHERENT_RAYS_PER_LEAF: u32 = 2;
+#[cfg(target_arch = "x86_64")]
+const INCOHERENT_AFTER_LEAVES: u32 = 16;
+
+#[cfg(test)]
+thread_local! {
+    /// Sparse packets sent one ray at a time on this thread (for the tests).
+    pub(super) static GAVE_UP: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 impl TriangleBvh {
     /// Closest hits of a packet of eight rays (`o[i]`, `d[i]`) in (t_min, t_max[i]), for the
     /// rays whose bit is set in `active`; a ray that hits has its `t_max` lowered to the hit.
@@ -33,12 +48,41 @@ impl TriangleBvh {
         t_min: f32,
         t_max: &mut [f32; WIDTH],
     ) -> [Option<TriangleHit>; WIDTH] {
+        self.closest_hit8_with(o, d, active, t_min, t_max, false)
+    }
+
+    /// `closest_hit8` for rays that may lie far apart (a coarse pass's sparse samples): a
+    /// packet whose first leaves are entered by few of its rays is traced again one ray at a
+    /// time, giving exactly the single rays' hits.
+    #[inline]
+    pub fn closest_hit8_sparse(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+    ) -> [Option<TriangleHit>; WIDTH] {
+        self.closest_hit8_with(o, d, active, t_min, t_max, true)
+    }
+
+    #[inline(always)]
+    fn closest_hit8_with(
+        &self,
+        o: &[Vec3A; WIDTH],
+        d: &[Vec3A; WIDTH],
+        active: u8,
+        t_min: f32,
+        t_max: &mut [f32; WIDTH],
+        sparse: bool,
+    ) -> [Option<TriangleHit>; WIDTH] {
         #[cfg(target_arch = "x86_64")]
         if has_avx() {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX, checked just above.
-            return unsafe { self.packet_avx(o, d, active, t_min, t_max) };
+            return unsafe { self.packet_avx(o, d, active, t_min, t_max, sparse) };
         }
+        let _ = sparse;
         self.singles8(o, d, active, t_min, t_max)
     }
 
@@ -77,6 +121,7 @@ impl TriangleBvh {
         active: u8,
         t_min: f32,
         t_max: &mut [f32; WIDTH],
+        sparse: bool,
     ) -> [Option<TriangleHit>; WIDTH] {
         let mut out = [None; WIDTH];
         if self.nodes.is_empty() || active == 0 {
@@ -103,6 +148,7 @@ impl TriangleBvh {
         // Where cur's box is stored (node * 8 + slot); unused for the root, never a leaf
         // except in a one-slot root, whose box is the root's box.
         let mut cur_box = u32::MAX;
+        let (mut leaves, mut leaf_rays) = (0u32, 0u32);
         loop {
             if wide::is_leaf(cur) {
                 let (first, count) = wide::leaf_range(cur);
@@ -114,6 +160,16 @@ impl TriangleBvh {
                     let n = &self.nodes[(cur_box / 8) as usize];
                     p.rays_entering(n, (cur_box % 8) as usize, t_min, &t_best) & live
                 };
+                if sparse {
+                    leaves += 1;
+                    leaf_rays += rays.count_ones();
+                    // t_max still holds the callers' bounds: nothing is written until the end.
+                    if leaves == INCOHERENT_AFTER_LEAVES && leaf_rays < INCOHERENT_RAYS_PER_LEAF * leaves {
+                        #[cfg(test)]
+                        GAVE_UP.with(|g| g.set(g.get() + 1));
+                        return self.singles8(o, d, active, t_min, t_max);
+                    }
+                }
                 let mut hit = false;
                 while rays != 0 {
                     let i = rays.trailing_zeros() as usize;

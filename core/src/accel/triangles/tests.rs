@@ -403,6 +403,11 @@ fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8
                     "packet {p} ray {i}: t_max"
                 );
             }
+            // The sparse variant (incoherent packets one ray at a time) agrees too.
+            let mut t_sparse = limits;
+            let sparse = bvh.closest_hit8_sparse(&o, &d, active, t_min, &mut t_sparse);
+            assert_eq!(t_sparse.map(f32::to_bits), t_packet.map(f32::to_bits), "sparse, packet {p}");
+            assert_eq!(sparse.map(|h| h.map(|h| h.t)), got.map(|h| h.map(|h| h.t)), "sparse, packet {p}");
             // The portable fallback (single rays) agrees too.
             let mut t_singles = limits;
             let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
@@ -520,6 +525,28 @@ fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
     let mut zero = coherent;
     zero[5].y = 0.0;
     assert_eq!(packet(zero), None, "one ray is parallel to the xz plane");
+}
+
+/// The sparse variant gives up on packets whose rays lie far apart on a fine mesh (and only
+/// on those: a dense tile of the same camera stays a packet), with the single rays' hits.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn sparse_packets_of_rays_far_apart_go_one_by_one() {
+    assert!(has_avx(), "this test checks the AVX packet path: run it on a CPU with AVX");
+    let (pos, tris) = random_mesh(20_000, 23);
+    let bvh = build_checked(&pos, &tris);
+    let eye = Vec3::new(0.3, 0.4, 6.0);
+    let gave_up = |rays: &[Ray]| {
+        super::packet::GAVE_UP.with(|g| g.set(0));
+        assert!(assert_packets_agree(&bvh, rays, 0.0, &[0xff]) > 0);
+        super::packet::GAVE_UP.with(|g| g.get())
+    };
+    // 16×16 pixels over 0.9 rad: a packet spans about a quarter of the view.
+    let sparse = gave_up(&pinhole_tiles(eye, Vec3::ZERO, 16, 0.9));
+    assert!(sparse > 0, "no sparse packet went one by one");
+    // 512×512 over 0.02 rad: eight neighbouring rays, nearly one.
+    let dense = gave_up(&pinhole_tiles(eye, Vec3::ZERO, 512, 0.02));
+    assert_eq!(dense, 0, "a dense tile went one by one");
 }
 
 #[test]
