@@ -190,26 +190,18 @@ impl CompiledScene {
         self.intersect8_with(rays, active, t_min, t_max, false)
     }
 
-    /// `intersect8` for rays that may lie far apart (a coarse pass's samples): a one-mesh
-    /// scene's packet goes one ray at a time once it proves incoherent
-    /// (`TriangleBvh::closest_hit8_sparse`). The same hits.
-    pub fn intersect8_sparse(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
-        self.intersect8_with(rays, active, t_min, t_max, true)
-    }
-
+    /// `intersect8`; with `sparse` (a coarse pass's samples), a one-mesh scene's packet goes
+    /// one ray at a time once it proves incoherent (`TriangleBvh::closest_hit8_with`). The
+    /// same hits either way.
     #[inline(always)]
-    fn intersect8_with(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32, sparse: bool) -> [Option<Hit>; 8] {
+    pub fn intersect8_with(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32, sparse: bool) -> [Option<Hit>; 8] {
         if let Some(i) = self.single_mesh
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
         {
             let (org, dir) = Self::object_rays8(o, rays);
             let mut t = [t_max; 8];
-            let hits = if sparse {
-                m.accel.closest_hit8_sparse(&org, &dir, active, t_min, &mut t)
-            } else {
-                m.accel.closest_hit8(&org, &dir, active, t_min, &mut t)
-            };
+            let hits = m.accel.closest_hit8_with(&org, &dir, active, t_min, &mut t, sparse);
             return hits.map(|h| h.map(|h| Hit { t: h.t, object: i, prim: h.triangle }));
         }
         self.intersect_scene8(rays, active, t_min, t_max)

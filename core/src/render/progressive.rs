@@ -119,11 +119,7 @@ fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, ray
             r[k] = rays.row(row).ray(x);
         }
         let active = ((1u16 << chunk.len()) - 1) as u8;
-        let hits = if pass.scale >= SPARSE_FROM_SCALE {
-            scene.intersect8_sparse(&r, active, t_min, f32::INFINITY)
-        } else {
-            scene.intersect8(&r, active, t_min, f32::INFINITY)
-        };
+        let hits = scene.intersect8_with(&r, active, t_min, f32::INFINITY, pass.scale >= SPARSE_FROM_SCALE);
         let shaded = shade_packet(scene, &r, &hits, s);
         for (k, &(i, j)) in chunk.iter().enumerate() {
             let dst = &mut grid[pass.index(i, j)];
@@ -338,7 +334,7 @@ fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays
 const WRITE_WHOLE_FROM_SCALE: u32 = 4;
 
 /// Passes this coarse or coarser let an incoherent packet go one ray at a time
-/// (`intersect8_sparse`); in the finer passes the test misjudged packets that were paying.
+/// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
 const SPARSE_FROM_SCALE: u32 = 4;
 
 fn render_scales(

@@ -51,23 +51,11 @@ impl TriangleBvh {
         self.closest_hit8_with(o, d, active, t_min, t_max, false)
     }
 
-    /// `closest_hit8` for rays that may lie far apart (a coarse pass's sparse samples): a
-    /// packet whose first leaves are entered by few of its rays is traced again one ray at a
-    /// time, giving exactly the single rays' hits.
-    #[inline]
-    pub fn closest_hit8_sparse(
-        &self,
-        o: &[Vec3A; WIDTH],
-        d: &[Vec3A; WIDTH],
-        active: u8,
-        t_min: f32,
-        t_max: &mut [f32; WIDTH],
-    ) -> [Option<TriangleHit>; WIDTH] {
-        self.closest_hit8_with(o, d, active, t_min, t_max, true)
-    }
-
+    /// `closest_hit8`; with `sparse` (rays that may lie far apart, as a coarse pass's
+    /// samples), a packet whose first leaves are entered by few of its rays is traced again
+    /// one ray at a time, giving exactly the single rays' hits.
     #[inline(always)]
-    fn closest_hit8_with(
+    pub fn closest_hit8_with(
         &self,
         o: &[Vec3A; WIDTH],
         d: &[Vec3A; WIDTH],

@@ -405,7 +405,7 @@ fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8
             }
             // The sparse variant (incoherent packets one ray at a time) agrees too.
             let mut t_sparse = limits;
-            let sparse = bvh.closest_hit8_sparse(&o, &d, active, t_min, &mut t_sparse);
+            let sparse = bvh.closest_hit8_with(&o, &d, active, t_min, &mut t_sparse, true);
             assert_eq!(t_sparse.map(f32::to_bits), t_packet.map(f32::to_bits), "sparse, packet {p}");
             assert_eq!(sparse.map(|h| h.map(|h| h.t)), got.map(|h| h.map(|h| h.t)), "sparse, packet {p}");
             // The portable fallback (single rays) agrees too.
