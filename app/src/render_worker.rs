@@ -172,6 +172,15 @@ impl Drop for RenderWorker {
     }
 }
 
+/// From each frame's (passes done, passes planned): the passes every frame has done (all of
+/// them once every frame is finished), the most any plans, and whether all are finished.
+fn passes_of(frames: &[(usize, usize)]) -> (usize, usize, bool) {
+    let planned = frames.iter().map(|f| f.1).max().unwrap_or(0);
+    let finished = frames.iter().all(|&(done, plan)| plan > 0 && done == plan);
+    let least = frames.iter().map(|f| f.0).min().unwrap_or(0);
+    (if finished { planned } else { least }, planned, finished)
+}
+
 fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
     let log = log::log_enabled!(target: crate::logging::TIMES, log::Level::Info);
     while let Ok(mut next) = rx.recv() {
@@ -189,10 +198,12 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             .iter()
             .map(|_| Arc::new(SharedFrame::new()))
             .collect();
-        let passes_done: Vec<std::sync::atomic::AtomicUsize> = job
+        // Per frame: passes done and passes planned (a render may skip its 2× pass, and the
+        // two frames of the flip view may not both skip it).
+        let counts: Vec<[std::sync::atomic::AtomicUsize; 2]> = job
             .modes
             .iter()
-            .map(|_| std::sync::atomic::AtomicUsize::new(0))
+            .map(|_| Default::default())
             .collect();
         {
             // The UI keeps showing its previous image until this one has its first pass.
@@ -212,26 +223,28 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             };
             *p = Some(new);
         }
-        let on_pass = |i: usize, passes: usize| {
-            passes_done[i].fetch_add(1, Ordering::Relaxed);
-            let least = passes_done
-                .iter()
-                .map(|a| a.load(Ordering::Relaxed))
-                .min()
-                .unwrap_or(0);
+        let on_pass = |i: usize, info: tracelab_core::render::PassInfo| {
+            // Under the lock, so the last frame to finish sees the other's counts.
             let mut p = shared
                 .published
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner);
+            counts[i][0].store(info.pass + 1, Ordering::Relaxed);
+            counts[i][1].store(info.passes, Ordering::Relaxed);
+            let now: Vec<(usize, usize)> = counts
+                .iter()
+                .map(|c| (c[0].load(Ordering::Relaxed), c[1].load(Ordering::Relaxed)))
+                .collect();
+            let (done, planned, finished) = passes_of(&now);
             if let Some(p) = p.as_mut().filter(|p| p.job.request == job.request) {
-                p.passes = passes;
-                if least > p.passes_done {
-                    p.passes_done = least;
+                p.passes = planned;
+                if done > p.passes_done {
                     let t = job.submitted.elapsed();
-                    if least == 1 {
+                    if p.passes_done == 0 {
                         p.first_image = Some(t);
                     }
-                    if least == p.passes {
+                    p.passes_done = done;
+                    if finished {
                         p.full = Some(t);
                     }
                 }
@@ -251,7 +264,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 normal_transform: job.modes[i],
                 ..job.settings
             };
-            let pass = |info: tracelab_core::render::PassInfo| on_pass(i, info.passes);
+            let pass = |info: tracelab_core::render::PassInfo| on_pass(i, info);
             if job.coarse {
                 render_coarse(&compiled, &settings, &frames[i], &cancel, pass).is_ok()
             } else {
@@ -298,6 +311,19 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The flip view's two frames may plan different passes (one skipping its 2× pass): the
+    /// render is full once both are done, and not before.
+    #[test]
+    fn a_render_is_full_when_every_frame_has_done_its_own_passes() {
+        assert_eq!(passes_of(&[(0, 0), (0, 0)]), (0, 0, false));
+        assert_eq!(passes_of(&[(1, 4), (0, 0)]), (0, 4, false), "one frame yet to report");
+        assert_eq!(passes_of(&[(2, 3), (1, 4)]), (1, 4, false));
+        assert_eq!(passes_of(&[(3, 3), (3, 4)]), (3, 4, false), "the skipper done, the other not");
+        assert_eq!(passes_of(&[(3, 3), (4, 4)]), (4, 4, true));
+        assert_eq!(passes_of(&[(3, 3)]), (3, 3, true));
+        assert_eq!(passes_of(&[(2, 2), (2, 2)]), (2, 2, true), "coarse passes only");
+    }
 
     fn scene() -> Arc<Scene> {
         let out = tracelab_core::parse_scene(

@@ -135,11 +135,22 @@ fn bench_progressive_reports_coarse_before_full() {
     assert!(last.starts_with("PROGRESSIVE "), "last line: {last:?}");
     let (coarse, full) = (field(last, "coarse_ms"), field(last, "full_ms"));
     assert!(coarse > 0.0 && coarse <= full, "{last}");
-    // Each of the four passes' own time, the first being the coarse image's.
+    // Each pass's own time by its scale, the first being the coarse image's; this tiny scene's
+    // quick 4× pass leaves out the 2× one in some runs or all.
     let passes = out.lines().find_map(|l| l.strip_prefix("passes: ")).expect("a passes line");
-    let each: Vec<f64> = passes.split(" ms").next().unwrap_or_default().split(" + ").map(|v| v.parse().expect("a number")).collect();
-    assert_eq!(each.len(), 4, "{passes}");
-    assert!(each.iter().all(|&t| t >= 0.0) && (each[0] - coarse).abs() < 0.006, "{passes} / {last}");
+    let each: Vec<(&str, f64)> = passes
+        .split(" ms each")
+        .next()
+        .unwrap_or_default()
+        .split(" + ")
+        .map(|p| {
+            let (scale, rest) = p.split_once("× ").expect("scale× time");
+            (scale, rest.split(' ').next().and_then(|t| t.parse().ok()).expect("a number"))
+        })
+        .collect();
+    let scales: Vec<&str> = each.iter().map(|e| e.0).collect();
+    assert!(scales == ["8", "4", "2", "1"] || scales == ["8", "4", "1"], "{passes}");
+    assert!(each.iter().all(|e| e.1 >= 0.0) && (each[0].1 - coarse).abs() < 0.006, "{passes} / {last}");
 }
 
 #[test]

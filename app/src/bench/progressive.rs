@@ -27,7 +27,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
     let tracing = if b.single_rays { Tracing::SingleRays } else { Tracing::Packets };
-    // (first coarse image, full frame, each pass's own time), in ms.
+    // (first coarse image, full frame, each pass's scale and own time), in ms.
     let once = || {
         let start = Instant::now();
         let compiled = CompiledScene::new(&scene);
@@ -35,22 +35,31 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         if b.one_pass {
             std::hint::black_box(render_frame_traced(&compiled, &settings, tracing));
             let t = start.elapsed().as_secs_f64() * 1e3;
-            return (t, t, vec![t]);
+            return (t, t, vec![(1, t)]);
         }
-        let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |_| {
-            ends.push(start.elapsed().as_secs_f64() * 1e3);
+        let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |p| {
+            ends.push((p.scale, start.elapsed().as_secs_f64() * 1e3));
         });
-        let full = ends.last().copied().unwrap_or_else(|| start.elapsed().as_secs_f64() * 1e3);
+        let full = ends.last().map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |e| e.1);
         // The first pass's time counts from the compile, as the coarse image's does.
-        let passes = ends.iter().scan(0.0, |before, &end| Some(end - std::mem::replace(before, end))).collect();
-        (ends.first().copied().unwrap_or(full), full, passes)
+        let passes = ends.iter().scan(0.0, |before, &(s, end)| Some((s, end - std::mem::replace(before, end)))).collect();
+        (ends.first().map_or(full, |e| e.1), full, passes)
     };
     once(); // warm-up
-    let runs: Vec<(f64, f64, Vec<f64>)> = (0..b.repeat.max(1)).map(|_| once()).collect();
+    let runs: Vec<(f64, f64, Vec<(u32, f64)>)> = (0..b.repeat.max(1)).map(|_| once()).collect();
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
-    let passes: Vec<String> = (0..runs[0].2.len())
-        .map(|i| format!("{:.2}", median(runs.iter().filter_map(|r| r.2.get(i).copied()).collect())))
+    // Each pass by its scale: a quick 4× pass leaves out the 2× one, maybe in some runs only.
+    let mut scales: Vec<u32> = runs.iter().flat_map(|r| r.2.iter().map(|p| p.0)).collect();
+    scales.sort_unstable_by(|a, b| b.cmp(a));
+    scales.dedup();
+    let passes: Vec<String> = scales
+        .iter()
+        .map(|&s| {
+            let times: Vec<f64> = runs.iter().flat_map(|r| r.2.iter().filter(|p| p.0 == s).map(|p| p.1)).collect();
+            let some = if times.len() < runs.len() { format!(" (in {} of {} runs)", times.len(), runs.len()) } else { String::new() };
+            format!("{s}× {:.2}{some}", median(times))
+        })
         .collect();
     out!(
         "frame: {w}x{h}, {} threads, {} kernels, medians of {}, {}, primary rays {}",
@@ -60,7 +69,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         if b.one_pass { "one full-resolution pass" } else { "coarse passes, then the full one" },
         if b.single_rays { "one at a time" } else { "in packets of 8" }
     );
-    out!("passes: {} ms each (medians; the first from the compile on)", passes.join(" + "));
+    out!("passes: {} ms each (scale, median; the first from the compile on)", passes.join(" + "));
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
     if let Some(steps) = b.orbit {
         run_orbit(&scene, &settings, steps.max(1))?;

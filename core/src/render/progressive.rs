@@ -1,6 +1,7 @@
 //! The progressive, cancellable renderer. A render runs in passes from coarse (one ray per
 //! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
-//! so the last pass leaves exactly the image a single full pass would. Tiles are rendered in
+//! so the last pass leaves exactly the image a single full pass would. The half-resolution
+//! pass is left out when the quarter-resolution one shows the full image will come quickly. Tiles are rendered in
 //! parallel with rayon and copied into a shared frame that another thread may read at any
 //! time: tile by tile in the fine passes, a whole pass at once in the coarse ones (cheap to
 //! trace, dear to write); a cancel flag stops the work within one tile.
@@ -21,6 +22,13 @@ use crate::geometry::Ray;
 
 const TILE: u32 = 64;
 const SCALES: [u32; 4] = [8, 4, 2, 1];
+
+/// The half-resolution pass is skipped when the full-resolution rays left would take less
+/// than this at the quarter-resolution pass's time per ray. That time overstates a full
+/// pass's two to six times (sparse packets, a frame written per pass), so the full image
+/// then comes within about a tenth of a second of the quarter one, where a half-resolution
+/// image would barely show and cost 10–17% of the render (docs/perf.md).
+const SKIP_HALF_BELOW: Duration = Duration::from_millis(250);
 
 /// A frame being filled by a render and read by others (the GUI) while it fills.
 #[derive(Debug)]
@@ -69,6 +77,7 @@ impl SharedFrame {
 pub struct PassInfo {
     /// 0-based index of the pass just completed.
     pub pass: usize,
+    /// Passes this render makes: one fewer from the 4× pass on when it skips the 2× pass.
     pub passes: usize,
     /// Pixels per traced sample along each axis in this pass (8, 4, 2, then 1).
     pub scale: u32,
@@ -205,7 +214,7 @@ pub fn render_progressive(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, Tracing::default(), &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES, Some(SKIP_HALF_BELOW), Tracing::default(), &mut on_pass)
 }
 
 /// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
@@ -217,7 +226,7 @@ pub fn render_coarse(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES[..2], Tracing::default(), &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES[..2], None, Tracing::default(), &mut on_pass)
 }
 
 /// Renders the full-resolution image in one pass.
@@ -229,7 +238,7 @@ pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
 pub fn render_frame_traced(scene: &CompiledScene, settings: &RenderSettings, tracing: Tracing) -> Frame {
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
-    let _ = render_scales(scene, settings, &target, &never, &[1], tracing, &mut |_| {});
+    let _ = render_scales(scene, settings, &target, &never, &[1], None, tracing, &mut |_| {});
     std::mem::replace(&mut *target.lock(), Frame::new(0, 0))
 }
 
@@ -243,7 +252,7 @@ pub fn render_progressive_traced(
     tracing: Tracing,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, tracing, &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES, Some(SKIP_HALF_BELOW), tracing, &mut on_pass)
 }
 
 /// One full-resolution pass into `target` (which others may watch for progress).
@@ -253,7 +262,7 @@ pub fn render_full(
     target: &SharedFrame,
     cancel: &AtomicBool,
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &[1], Tracing::default(), &mut |_| {})
+    render_scales(scene, settings, target, cancel, &[1], None, Tracing::default(), &mut |_| {})
 }
 
 /// The grid points of a tile's pass not traced before, in 4×2 neighbourhoods (two rows, four
@@ -337,12 +346,28 @@ const WRITE_WHOLE_FROM_SCALE: u32 = 4;
 /// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
 const SPARSE_FROM_SCALE: u32 = 4;
 
+/// Whether to skip the 2× pass that `plan` has next, after a 4× pass that took `took`: when
+/// the full-resolution rays left would take less than `below` at that pass's time per ray.
+fn skip_half(plan: &[u32], pass: usize, took: Duration, (w, h): (u32, u32), below: Option<Duration>) -> bool {
+    let Some(below) = below else { return false };
+    if plan.get(pass..pass + 3) != Some(&[4, 2, 1][..]) {
+        return false;
+    }
+    // Grid points of a pass over the whole frame (tiles' partial blocks aside).
+    let points = |s: u32| f64::from(w.div_ceil(s)) * f64::from(h.div_ceil(s));
+    let traced = points(4) - plan.get(pass.wrapping_sub(1)).map_or(0.0, |&c| points(c));
+    let left = f64::from(w) * f64::from(h) - points(4);
+    traced > 0.0 && took.as_secs_f64() / traced * left < below.as_secs_f64()
+}
+
+#[allow(clippy::too_many_arguments)]
 fn render_scales(
     scene: &CompiledScene,
     settings: &RenderSettings,
     target: &SharedFrame,
     cancel: &AtomicBool,
     scales: &[u32],
+    skip_half_below: Option<Duration>,
     tracing: Tracing,
     on_pass: &mut dyn FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
@@ -365,8 +390,11 @@ fn render_scales(
     let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     target.tiles_done.store(0, Ordering::Relaxed);
     target.tiles_total.store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
-    for (pass, &scale) in scales.iter().enumerate() {
-        let coarser = (pass > 0).then(|| scales[pass - 1]);
+    let mut plan = scales.to_vec();
+    let mut pass = 0;
+    while let Some(&scale) = plan.get(pass) {
+        let pass_start = Instant::now();
+        let coarser = (pass > 0).then(|| plan[pass - 1]);
         let tile_pass = |&(tx, ty): &(u32, u32)| {
             let (x0, y0) = (tx * TILE, ty * TILE);
             TilePass::new((x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)), scale, coarser)
@@ -416,7 +444,12 @@ fn render_scales(
                 Ok(())
             })?;
         }
-        on_pass(PassInfo { pass, passes: scales.len(), scale, elapsed: start.elapsed() });
+        if skip_half(&plan, pass, pass_start.elapsed(), (w, h), skip_half_below) {
+            plan.remove(pass + 1);
+            target.tiles_total.store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
+        }
+        on_pass(PassInfo { pass, passes: plan.len(), scale, elapsed: start.elapsed() });
+        pass += 1;
     }
     Ok(())
 }
@@ -429,7 +462,8 @@ mod tests {
     /// What the viewport shows after each pass: every pixel holds the sample of its block's
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
     /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
-    /// written whole and those written tile by tile, packets and single rays.
+    /// written whole and those written tile by tile, packets and single rays, with the 2×
+    /// pass and without it (the full pass then fills in around the 4× grid).
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/nested_transforms.txt");
@@ -440,23 +474,48 @@ mod tests {
             let full = render_frame(&c, &s);
             assert!(full.samples.iter().any(Sample::is_hit) && full.samples.iter().any(|p| !p.is_hit()), "{w}x{h}");
             for tracing in [Tracing::Packets, Tracing::SingleRays] {
-                let target = SharedFrame::new();
-                let never = AtomicBool::new(false);
-                let mut shown = Vec::new();
-                render_progressive_traced(&c, &s, &target, &never, tracing, |p| shown.push((p.scale, target.lock().clone())))
+                for (skip, scales, passes) in [(None, &SCALES[..], [4, 4, 4, 4]), (Some(Duration::MAX), &[8, 4, 1][..], [4, 3, 3, 0])] {
+                    let target = SharedFrame::new();
+                    let never = AtomicBool::new(false);
+                    let mut shown = Vec::new();
+                    render_scales(&c, &s, &target, &never, &SCALES, skip, tracing, &mut |p| {
+                        shown.push((p.scale, p.passes, target.lock().clone()));
+                    })
                     .expect("not cancelled");
-                assert_eq!(shown.iter().map(|(s, _)| *s).collect::<Vec<_>>(), SCALES);
-                for (scale, f) in &shown {
-                    for y in 0..h {
-                        for x in 0..w {
-                            let corner = full.get(x - x % scale, y - y % scale);
-                            assert_eq!(f.get(x, y), corner, "{w}x{h} {tracing:?} after the {scale}× pass, pixel ({x}, {y})");
+                    assert_eq!(shown.iter().map(|(s, _, _)| *s).collect::<Vec<_>>(), scales);
+                    assert_eq!(shown.iter().map(|(_, n, _)| *n).collect::<Vec<_>>(), passes[..scales.len()]);
+                    for (scale, _, f) in &shown {
+                        for y in 0..h {
+                            for x in 0..w {
+                                let corner = full.get(x - x % scale, y - y % scale);
+                                assert_eq!(f.get(x, y), corner, "{w}x{h} {tracing:?} {skip:?} after the {scale}× pass, pixel ({x}, {y})");
+                            }
                         }
                     }
+                    assert_eq!(target.progress(), 1.0);
                 }
-                assert_eq!(target.progress(), 1.0);
             }
         }
+    }
+
+    /// The 2× pass is skipped only next in 8, 4, 2, 1, after a 4× pass quick enough that the
+    /// full pass's rays, at its time per ray, would take less than the bound: at 800², the
+    /// 4× pass traces 30,000 rays and 600,000 are left, so 250 ms allows a 4× pass of 12.5 ms.
+    #[test]
+    fn the_half_pass_is_skipped_when_the_quarter_one_was_quick() {
+        let ms = Duration::from_millis;
+        let below = Some(SKIP_HALF_BELOW);
+        assert_eq!(SKIP_HALF_BELOW, ms(250));
+        assert!(skip_half(&SCALES, 1, ms(12), (800, 800), below));
+        assert!(!skip_half(&SCALES, 1, ms(13), (800, 800), below));
+        // Any size leaves about 20 times the 4× pass's rays: the time per ray decides.
+        assert!(skip_half(&SCALES, 1, ms(12), (3840, 2160), below));
+        assert!(!skip_half(&SCALES, 1, ms(13), (3840, 2160), below));
+        assert!(!skip_half(&SCALES, 1, ms(1), (800, 800), None));
+        assert!(!skip_half(&SCALES, 0, ms(1), (800, 800), below), "after the 8× pass");
+        assert!(!skip_half(&SCALES[..2], 1, ms(1), (800, 800), below), "the coarse passes alone");
+        assert!(!skip_half(&[4, 1], 0, ms(1), (800, 800), below), "no 2× pass to skip");
+        assert!(skip_half(&[4, 2, 1], 0, ms(1), (800, 800), below), "a plan starting at 4×");
     }
 
     /// A cancel before a pass is written leaves the frame as the last pass left it.
@@ -477,3 +536,4 @@ mod tests {
         assert_eq!(after_first.as_ref(), Some(&*target.lock()));
     }
 }
+
