@@ -198,8 +198,8 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             .iter()
             .map(|_| Arc::new(SharedFrame::new()))
             .collect();
-        // Per frame: passes done and passes planned (a render may skip its 2× pass, and the
-        // two frames of the flip view may not both skip it).
+        // Per frame: passes done and passes planned (a quick coarse pass skips the passes
+        // before the full one, and the flip view's two frames may not skip the same).
         let counts: Vec<[std::sync::atomic::AtomicUsize; 2]> = job
             .modes
             .iter()
@@ -312,7 +312,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
 mod tests {
     use super::*;
 
-    /// The flip view's two frames may plan different passes (one skipping its 2× pass): the
+    /// The flip view's two frames may plan different passes (one skipping some): the
     /// render is full once both are done, and not before.
     #[test]
     fn a_render_is_full_when_every_frame_has_done_its_own_passes() {

@@ -136,7 +136,7 @@ fn bench_progressive_reports_coarse_before_full() {
     let (coarse, full) = (field(last, "coarse_ms"), field(last, "full_ms"));
     assert!(coarse > 0.0 && coarse <= full, "{last}");
     // Each pass's own time by its scale, the first being the coarse image's; this tiny scene's
-    // quick 4× pass leaves out the 2× one in some runs or all.
+    // quick coarse passes go straight to the full one in some runs or all.
     let passes = out.lines().find_map(|l| l.strip_prefix("passes: ")).expect("a passes line");
     let each: Vec<(&str, f64)> = passes
         .split(" ms each")
@@ -149,7 +149,7 @@ fn bench_progressive_reports_coarse_before_full() {
         })
         .collect();
     let scales: Vec<&str> = each.iter().map(|e| e.0).collect();
-    assert!(scales == ["8", "4", "2", "1"] || scales == ["8", "4", "1"], "{passes}");
+    assert!([&["8", "4", "2", "1"][..], &["8", "4", "1"], &["8", "1"]].contains(&&scales[..]), "{passes}");
     assert!(each.iter().all(|e| e.1 >= 0.0) && (each[0].1 - coarse).abs() < 0.006, "{passes} / {last}");
 }
 

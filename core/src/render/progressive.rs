@@ -1,7 +1,8 @@
 //! The progressive, cancellable renderer. A render runs in passes from coarse (one ray per
 //! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
-//! so the last pass leaves exactly the image a single full pass would. The half-resolution
-//! pass is left out when the quarter-resolution one shows the full image will come quickly. Tiles are rendered in
+//! so the last pass leaves exactly the image a single full pass would. The passes between a
+//! coarse pass and the full one are left out when that coarse pass shows the full image will
+//! come quickly. Tiles are rendered in
 //! parallel with rayon and copied into a shared frame that another thread may read at any
 //! time: tile by tile in the fine passes, a whole pass at once in the coarse ones (cheap to
 //! trace, dear to write); a cancel flag stops the work within one tile.
@@ -23,12 +24,12 @@ use crate::geometry::Ray;
 const TILE: u32 = 64;
 const SCALES: [u32; 4] = [8, 4, 2, 1];
 
-/// The half-resolution pass is skipped when the full-resolution rays left would take less
-/// than this at the quarter-resolution pass's time per ray. That time overstates a full
-/// pass's two to six times (sparse packets, a frame written per pass), so the full image
-/// then comes within about a tenth of a second of the quarter one, where a half-resolution
-/// image would barely show and cost 10–17% of the render (docs/perf.md).
-const SKIP_HALF_BELOW: Duration = Duration::from_millis(250);
+/// After a coarse pass, the render goes straight to the full-resolution pass when the rays
+/// that pass has left would take less than this at the coarse pass's time per ray. That time
+/// overstates a full pass's several times over (sparse packets, the whole frame written for
+/// few rays), so the full image then follows within some tens of milliseconds, where the
+/// finer previews would barely show and cost a tenth to a quarter of the render (docs/perf.md).
+const STRAIGHT_TO_FULL_BELOW: Duration = Duration::from_millis(250);
 
 /// A frame being filled by a render and read by others (the GUI) while it fills.
 #[derive(Debug)]
@@ -77,7 +78,8 @@ impl SharedFrame {
 pub struct PassInfo {
     /// 0-based index of the pass just completed.
     pub pass: usize,
-    /// Passes this render makes: one fewer from the 4× pass on when it skips the 2× pass.
+    /// Passes this render makes: fewer from a quick coarse pass on, which skips the passes
+    /// between it and the full one.
     pub passes: usize,
     /// Pixels per traced sample along each axis in this pass (8, 4, 2, then 1).
     pub scale: u32,
@@ -214,7 +216,7 @@ pub fn render_progressive(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, Some(SKIP_HALF_BELOW), Tracing::default(), &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES, Some(STRAIGHT_TO_FULL_BELOW), Tracing::default(), &mut on_pass)
 }
 
 /// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
@@ -252,7 +254,7 @@ pub fn render_progressive_traced(
     tracing: Tracing,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, Some(SKIP_HALF_BELOW), tracing, &mut on_pass)
+    render_scales(scene, settings, target, cancel, &SCALES, Some(STRAIGHT_TO_FULL_BELOW), tracing, &mut on_pass)
 }
 
 /// One full-resolution pass into `target` (which others may watch for progress).
@@ -346,18 +348,20 @@ const WRITE_WHOLE_FROM_SCALE: u32 = 4;
 /// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
 const SPARSE_FROM_SCALE: u32 = 4;
 
-/// Whether to skip the 2× pass that `plan` has next, after a 4× pass that took `took`: when
-/// the full-resolution rays left would take less than `below` at that pass's time per ray.
-fn skip_half(plan: &[u32], pass: usize, took: Duration, (w, h): (u32, u32), below: Option<Duration>) -> bool {
-    let Some(below) = below else { return false };
-    if plan.get(pass..pass + 3) != Some(&[4, 2, 1][..]) {
-        return false;
+/// How many passes to skip after pass `pass` of `plan`, which took `took`: those between it
+/// and the full-resolution pass that ends the plan, when the full pass's rays would take
+/// less than `below` at this pass's time per ray.
+fn passes_to_skip(plan: &[u32], pass: usize, took: Duration, (w, h): (u32, u32), below: Option<Duration>) -> usize {
+    let Some(below) = below else { return 0 };
+    let between = plan.len().saturating_sub(pass + 2);
+    if between == 0 || plan.last() != Some(&1) {
+        return 0;
     }
     // Grid points of a pass over the whole frame (tiles' partial blocks aside).
     let points = |s: u32| f64::from(w.div_ceil(s)) * f64::from(h.div_ceil(s));
-    let traced = points(4) - plan.get(pass.wrapping_sub(1)).map_or(0.0, |&c| points(c));
-    let left = f64::from(w) * f64::from(h) - points(4);
-    traced > 0.0 && took.as_secs_f64() / traced * left < below.as_secs_f64()
+    let traced = points(plan[pass]) - pass.checked_sub(1).map_or(0.0, |p| points(plan[p]));
+    let left = f64::from(w) * f64::from(h) - points(plan[pass]);
+    if traced > 0.0 && took.as_secs_f64() / traced * left < below.as_secs_f64() { between } else { 0 }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -367,7 +371,7 @@ fn render_scales(
     target: &SharedFrame,
     cancel: &AtomicBool,
     scales: &[u32],
-    skip_half_below: Option<Duration>,
+    straight_to_full_below: Option<Duration>,
     tracing: Tracing,
     on_pass: &mut dyn FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
@@ -444,8 +448,9 @@ fn render_scales(
                 Ok(())
             })?;
         }
-        if skip_half(&plan, pass, pass_start.elapsed(), (w, h), skip_half_below) {
-            plan.remove(pass + 1);
+        let skip = passes_to_skip(&plan, pass, pass_start.elapsed(), (w, h), straight_to_full_below);
+        if skip > 0 {
+            plan.drain(pass + 1..pass + 1 + skip);
             target.tiles_total.store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
         }
         on_pass(PassInfo { pass, passes: plan.len(), scale, elapsed: start.elapsed() });
@@ -462,8 +467,9 @@ mod tests {
     /// What the viewport shows after each pass: every pixel holds the sample of its block's
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
     /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
-    /// written whole and those written tile by tile, packets and single rays, with the 2×
-    /// pass and without it (the full pass then fills in around the 4× grid).
+    /// written whole and those written tile by tile, packets and single rays, every pass made
+    /// and a quick 8× pass going straight to the full one (which then fills in around the 8×
+    /// grid), or a full pass after the 4× one.
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/nested_transforms.txt");
@@ -474,16 +480,22 @@ mod tests {
             let full = render_frame(&c, &s);
             assert!(full.samples.iter().any(Sample::is_hit) && full.samples.iter().any(|p| !p.is_hit()), "{w}x{h}");
             for tracing in [Tracing::Packets, Tracing::SingleRays] {
-                for (skip, scales, passes) in [(None, &SCALES[..], [4, 4, 4, 4]), (Some(Duration::MAX), &[8, 4, 1][..], [4, 3, 3, 0])] {
+                // (plan, bound, the passes shown, PassInfo::passes after each)
+                let plans: [(&[u32], _, &[u32], &[usize]); 3] = [
+                    (&SCALES, None, &SCALES, &[4, 4, 4, 4]),
+                    (&SCALES, Some(Duration::MAX), &[8, 1], &[2, 2]),
+                    (&[8, 4, 1], None, &[8, 4, 1], &[3, 3, 3]),
+                ];
+                for (plan, skip, scales, passes) in plans {
                     let target = SharedFrame::new();
                     let never = AtomicBool::new(false);
                     let mut shown = Vec::new();
-                    render_scales(&c, &s, &target, &never, &SCALES, skip, tracing, &mut |p| {
+                    render_scales(&c, &s, &target, &never, plan, skip, tracing, &mut |p| {
                         shown.push((p.scale, p.passes, target.lock().clone()));
                     })
                     .expect("not cancelled");
                     assert_eq!(shown.iter().map(|(s, _, _)| *s).collect::<Vec<_>>(), scales);
-                    assert_eq!(shown.iter().map(|(_, n, _)| *n).collect::<Vec<_>>(), passes[..scales.len()]);
+                    assert_eq!(shown.iter().map(|(_, n, _)| *n).collect::<Vec<_>>(), passes);
                     for (scale, _, f) in &shown {
                         for y in 0..h {
                             for x in 0..w {
@@ -498,24 +510,29 @@ mod tests {
         }
     }
 
-    /// The 2× pass is skipped only next in 8, 4, 2, 1, after a 4× pass quick enough that the
-    /// full pass's rays, at its time per ray, would take less than the bound: at 800², the
-    /// 4× pass traces 30,000 rays and 600,000 are left, so 250 ms allows a 4× pass of 12.5 ms.
+    /// A coarse pass skips the passes between it and the full one when the full pass's rays
+    /// would take less than the bound at its time per ray. At 800², the 8× pass traces 10,000
+    /// rays and leaves 630,000 (250 ms allows 3.97 ms); the 4× pass traces 30,000 and leaves
+    /// 600,000 (12.5 ms).
     #[test]
-    fn the_half_pass_is_skipped_when_the_quarter_one_was_quick() {
+    fn a_quick_coarse_pass_goes_straight_to_the_full_one() {
         let ms = Duration::from_millis;
-        let below = Some(SKIP_HALF_BELOW);
-        assert_eq!(SKIP_HALF_BELOW, ms(250));
-        assert!(skip_half(&SCALES, 1, ms(12), (800, 800), below));
-        assert!(!skip_half(&SCALES, 1, ms(13), (800, 800), below));
-        // Any size leaves about 20 times the 4× pass's rays: the time per ray decides.
-        assert!(skip_half(&SCALES, 1, ms(12), (3840, 2160), below));
-        assert!(!skip_half(&SCALES, 1, ms(13), (3840, 2160), below));
-        assert!(!skip_half(&SCALES, 1, ms(1), (800, 800), None));
-        assert!(!skip_half(&SCALES, 0, ms(1), (800, 800), below), "after the 8× pass");
-        assert!(!skip_half(&SCALES[..2], 1, ms(1), (800, 800), below), "the coarse passes alone");
-        assert!(!skip_half(&[4, 1], 0, ms(1), (800, 800), below), "no 2× pass to skip");
-        assert!(skip_half(&[4, 2, 1], 0, ms(1), (800, 800), below), "a plan starting at 4×");
+        let us = Duration::from_micros;
+        let below = Some(STRAIGHT_TO_FULL_BELOW);
+        assert_eq!(STRAIGHT_TO_FULL_BELOW, ms(250));
+        let skip = |plan: &[u32], pass, took, size| passes_to_skip(plan, pass, took, size, below);
+        assert_eq!(skip(&SCALES, 0, us(3_950), (800, 800)), 2);
+        assert_eq!(skip(&SCALES, 0, us(4_000), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 1, ms(12), (800, 800)), 1);
+        assert_eq!(skip(&SCALES, 1, ms(13), (800, 800)), 0);
+        // Any size leaves about the same multiple of a pass's rays: the time per ray decides.
+        assert_eq!(skip(&SCALES, 1, ms(12), (3840, 2160)), 1);
+        assert_eq!(skip(&SCALES, 1, ms(13), (3840, 2160)), 0);
+        assert_eq!(passes_to_skip(&SCALES, 0, ms(1), (800, 800), None), 0);
+        assert_eq!(skip(&SCALES, 2, ms(1), (800, 800)), 0, "nothing between 2× and 1×");
+        assert_eq!(skip(&SCALES[..2], 0, ms(1), (800, 800)), 0, "the coarse passes alone");
+        assert_eq!(skip(&[8, 4, 1], 0, ms(1), (800, 800)), 1);
+        assert_eq!(skip(&[1], 0, ms(1), (800, 800)), 0, "one full pass");
     }
 
     /// A cancel before a pass is written leaves the frame as the last pass left it.
