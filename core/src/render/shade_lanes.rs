@@ -91,9 +91,11 @@ fn shade_packet_with(
 /// What the lanes need, gathered from the scene.
 #[derive(Clone, Copy, Default)]
 struct Input {
-    /// Lanes to shade here, and of those the ones with a normal matrix.
+    /// Lanes to shade here.
     lanes: u8,
-    transformed: u8,
+    /// 1 in the lanes with a normal matrix, else 0: a float per lane, so that choosing
+    /// between the two normals compiles to one blend, not a branch per lane.
+    transformed: Lanes,
     dir: V3,
     a: V3,
     b: V3,
@@ -111,7 +113,7 @@ impl Input {
         }
     }
     fn set_matrix(&mut self, k: usize, cols: [f32; 9]) {
-        self.transformed |= 1 << k;
+        self.transformed[k] = 1.0;
         for (row, v) in self.m.iter_mut().zip(cols) {
             row[k] = v;
         }
@@ -156,7 +158,9 @@ fn dot(a: &V3, b: &V3) -> Lanes {
 fn normalize_or(v: &V3, fallback: &V3) -> V3 {
     let d = dot(v, v);
     let rcp = map(|k| 1.0 / d[k].sqrt());
-    let ok = map(|k| if rcp[k].is_finite() && rcp[k] > 0.0 { 1.0 } else { 0.0 });
+    // Finite and positive, as 0 < r < ∞ (false for NaN): two compares and an and, where
+    // `is_finite() && > 0.0` compiled to a branch per lane.
+    let ok = map(|k| if (rcp[k] > 0.0) & (rcp[k] < f32::INFINITY) { 1.0 } else { 0.0 });
     let pick = |v: &Lanes, f: &Lanes| map(|k| if ok[k] != 0.0 { v[k] * rcp[k] } else { f[k] });
     V3 { x: pick(&v.x, &fallback.x), y: pick(&v.y, &fallback.y), z: pick(&v.z, &fallback.z) }
 }
@@ -181,8 +185,8 @@ fn lanes(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool
     let m = &input.m;
     let row = |i: usize| map(|k| (m[i][k] * n_obj.x[k]) + (m[3 + i][k] * n_obj.y[k]) + (m[6 + i][k] * n_obj.z[k]));
     let moved = normalize_or(&V3 { x: row(0), y: row(1), z: row(2) }, &n_obj);
-    let t = input.transformed;
-    let keep = |a: &Lanes, b: &Lanes| map(|k| if t & (1 << k) != 0 { a[k] } else { b[k] });
+    let t = &input.transformed;
+    let keep = |a: &Lanes, b: &Lanes| map(|k| if t[k] != 0.0 { a[k] } else { b[k] });
     let normal = V3 { x: keep(&moved.x, &n_obj.x), y: keep(&moved.y, &n_obj.y), z: keep(&moved.z, &n_obj.z) };
 
     // `shade::lit`: black for a back face unless shade_back turns the normal to the eye.
@@ -203,7 +207,10 @@ fn lanes(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool
         c.y = map(|k| c.y[k] + (d[k] * color.y) * kd.y[k]);
         c.z = map(|k| c.z[k] + (d[k] * color.z) * kd.z[k]);
     }
-    let black = |v: &Lanes| map(|k| if back[k] != 0.0 && !shade_back { 0.0 } else { v[k] });
+    if shade_back {
+        return Shaded { color: c, normal };
+    }
+    let black = |v: &Lanes| map(|k| if back[k] != 0.0 { 0.0 } else { v[k] });
     Shaded { color: V3 { x: black(&c.x), y: black(&c.y), z: black(&c.z) }, normal }
 }
 
