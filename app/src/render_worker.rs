@@ -33,8 +33,9 @@ pub struct Published {
     pub compiled: Arc<CompiledScene>,
     /// One per `job.modes`, filled progressively.
     pub frames: Vec<Arc<SharedFrame>>,
-    /// Passes completed by every frame (the least of them).
+    /// Passes completed by every frame (the least of them; `passes` once all are done).
     pub passes_done: usize,
+    /// Passes planned, the most of any frame (fewer once a quick coarse pass skips some).
     pub passes: usize,
     pub first_image: Option<Duration>,
     pub full: Option<Duration>,

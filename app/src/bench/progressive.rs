@@ -49,7 +49,8 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let runs: Vec<(f64, f64, Vec<(u32, f64)>)> = (0..b.repeat.max(1)).map(|_| once()).collect();
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
-    // Each pass by its scale: a quick 4× pass leaves out the 2× one, maybe in some runs only.
+    // Each pass by its scale: a quick coarse pass leaves out the finer ones before the full
+    // pass, maybe in some runs only.
     let mut scales: Vec<u32> = runs.iter().flat_map(|r| r.2.iter().map(|p| p.0)).collect();
     scales.sort_unstable_by(|a, b| b.cmp(a));
     scales.dedup();

@@ -2,10 +2,10 @@
 //! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
 //! so the last pass leaves exactly the image a single full pass would. The passes between a
 //! coarse pass and the full one are left out when that coarse pass shows the full image will
-//! come quickly. Tiles are rendered in
-//! parallel with rayon and copied into a shared frame that another thread may read at any
-//! time: tile by tile in the fine passes, a whole pass at once in the coarse ones (cheap to
-//! trace, dear to write); a cancel flag stops the work within one tile.
+//! come quickly. Tiles are rendered in parallel with rayon and copied into a shared frame
+//! that another thread may read at any time: tile by tile in the fine passes, a whole pass
+//! at once in the coarse ones (cheap to trace, dear to write); a cancel flag stops the work
+//! within one tile.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
@@ -28,7 +28,7 @@ const SCALES: [u32; 4] = [8, 4, 2, 1];
 /// that pass has left would take less than this at the coarse pass's time per ray. That time
 /// overstates a full pass's several times over (sparse packets, the whole frame written for
 /// few rays), so the full image then follows within some tens of milliseconds, where the
-/// finer previews would barely show and cost a tenth to a quarter of the render (docs/perf.md).
+/// finer previews would barely show and cost a seventh to a third of the render (docs/perf.md).
 const STRAIGHT_TO_FULL_BELOW: Duration = Duration::from_millis(250);
 
 /// A frame being filled by a render and read by others (the GUI) while it fills.
@@ -553,4 +553,3 @@ mod tests {
         assert_eq!(after_first.as_ref(), Some(&*target.lock()));
     }
 }
-
