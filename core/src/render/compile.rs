@@ -212,10 +212,17 @@ impl CompiledScene {
     fn object_rays8(o: &Object, rays: &[Ray; 8]) -> ([Vec3A; 8], [Vec3A; 8]) {
         match &o.xf {
             // Direction deliberately not renormalised, as in `mesh_hit`.
-            Some(xf) => (
-                std::array::from_fn(|k| xf.object_from_world.transform_point3(rays[k].origin).into()),
-                std::array::from_fn(|k| xf.object_from_world.transform_vector3(rays[k].direction).into()),
-            ),
+            Some(xf) => {
+                let m = &xf.object_from_world;
+                // A perspective camera's rays share one origin: moved once, the same bits.
+                let origin = rays[0].origin;
+                let org = if rays.iter().all(|r| r.origin.to_array().map(f32::to_bits) == origin.to_array().map(f32::to_bits)) {
+                    [m.transform_point3(origin).into(); 8]
+                } else {
+                    std::array::from_fn(|k| m.transform_point3(rays[k].origin).into())
+                };
+                (org, std::array::from_fn(|k| m.transform_vector3(rays[k].direction).into()))
+            }
             None => (
                 std::array::from_fn(|k| rays[k].origin.into()),
                 std::array::from_fn(|k| rays[k].direction.into()),
