@@ -101,8 +101,54 @@ impl Frame {
 /// load, a failed store forward costing about a quarter of a frame's time (docs/perf.md).
 #[inline(always)]
 pub(super) fn write_sample(dst: &mut Sample, color: Vec3, normal: Vec3, t: f32, node: u32) {
-    dst.color = [quantize(color.x), quantize(color.y), quantize(color.z)];
-    dst.normal = [quantize(normal.x.abs()), quantize(normal.y.abs()), quantize(normal.z.abs())];
+    dst.color = quantize3(color);
+    dst.normal = quantize3(normal.abs());
     dst.t = t;
     dst.node = node;
+}
+
+/// `quantize` of each component, the three at once (SSE2, which every x86_64 CPU has):
+/// ×255, max with 0 (which also turns NaN into 0, as `NaN as u8` does), min with 255, then
+/// truncation — `quantize`'s result for every input (tested).
+#[inline(always)]
+fn quantize3(v: Vec3) -> [u8; 3] {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: SSE2 is part of every x86_64 CPU (the target's baseline), and these
+    // intrinsics work on registers only, touching no memory.
+    unsafe {
+        use std::arch::x86_64::*;
+        let x = _mm_mul_ps(_mm_setr_ps(v.x, v.y, v.z, 0.0), _mm_set1_ps(255.0));
+        // maxps gives its second operand when the first is NaN.
+        let x = _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(255.0));
+        let words = _mm_packs_epi32(_mm_cvttps_epi32(x), _mm_setzero_si128());
+        let [r, g, b, _] = (_mm_cvtsi128_si32(_mm_packus_epi16(words, words)) as u32).to_le_bytes();
+        [r, g, b]
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        [quantize(v.x), quantize(v.y), quantize(v.z)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The three-at-once quantiser gives the course's byte for the edge cases (NaN, the
+    /// infinities, signed zeros, values either side of every clamp and rounding edge) and a
+    /// sweep through [-0.5, 1.5].
+    #[test]
+    fn quantize3_is_quantize_for_every_input() {
+        let mut xs = vec![
+            f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0, f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE, 1e-45, 1.0, 1.0 - f32::EPSILON, 1.0 + f32::EPSILON, 0.5, 254.5 / 255.0,
+            1.0 / 255.0, 0.999_999_9 / 255.0, f32::MAX, f32::MIN, 1e10, -1e10, 8_388_608.0,
+        ];
+        xs.extend((0..=200_000).map(|i| -0.5 + i as f32 * 1e-5));
+        for w in xs.chunks(3) {
+            let v = Vec3::new(w[0], *w.get(1).unwrap_or(&0.25), *w.get(2).unwrap_or(&-3.0));
+            assert_eq!(quantize3(v), [quantize(v.x), quantize(v.y), quantize(v.z)], "{v:?}");
+        }
+    }
 }
