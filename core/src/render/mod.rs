@@ -4,6 +4,7 @@
 mod camera;
 mod compile;
 pub mod csg;
+mod cull;
 mod frame;
 mod inspect;
 mod limits;

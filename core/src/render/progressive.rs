@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::camera::PixelRays;
 use super::compile::CompiledScene;
+use super::cull::TileCull;
 use super::frame::{Frame, Sample, write_sample};
 use super::shade::shade_fast;
 use super::shade_lanes::shade_packet;
@@ -316,10 +317,18 @@ fn write_tile(band: &mut [Sample], w: usize, band_y0: u32, pass: &TilePass, grid
     }
 }
 
-/// Traces one tile's pass into a grid of its samples (the points traced before left unset).
-fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays, tracing: Tracing, tp: &TilePass) -> Vec<Sample> {
+/// Traces one tile's pass into a grid of its samples (the points traced before left unset,
+/// or, in a tile no ray can hit anything in, background like the rest).
+fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays, tracing: Tracing, cull: &TileCull, tp: &TilePass) -> Vec<Sample> {
     let mut grid = vec![Sample::UNSET; tp.points()];
     match tracing {
+        // Packets only: the single rays trace every pixel, so that the two agreeing shows
+        // that no culled pixel would have hit.
+        Tracing::Packets if !cull.may_hit((tp.x0, tp.y0, tp.x1, tp.y1)) => {
+            let mut miss = Sample::UNSET;
+            store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
+            grid.fill(miss);
+        }
         // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
         Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
             trace_packets(scene, settings, tp, rays, &points_to_trace(tp), &mut grid);
@@ -389,6 +398,7 @@ fn render_scales(
     }
     // The columns' share of every camera ray, once per render rather than per pixel.
     let rays = scene.camera.pixel_rays(w, h);
+    let cull = TileCull::new(scene, w, h);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
@@ -411,7 +421,7 @@ fn render_scales(
                         return Err(Cancelled);
                     }
                     let tp = tile_pass(t);
-                    let grid = trace_tile(scene, settings, &rays, tracing, &tp);
+                    let grid = trace_tile(scene, settings, &rays, tracing, &cull, &tp);
                     target.tiles_done.fetch_add(1, Ordering::Relaxed);
                     Ok((tp, grid))
                 })
@@ -440,7 +450,7 @@ fn render_scales(
                     return Err(Cancelled);
                 }
                 let tp = tile_pass(t);
-                let mut grid = trace_tile(scene, settings, &rays, tracing, &tp);
+                let mut grid = trace_tile(scene, settings, &rays, tracing, &cull, &tp);
                 let mut line = Vec::with_capacity(TILE as usize);
                 write_tile(&mut target.lock().samples, w as usize, 0, &tp, &mut grid, &mut line);
                 target.tiles_done.fetch_add(1, Ordering::Relaxed);
