@@ -109,7 +109,7 @@ pub(super) fn write_sample(dst: &mut Sample, color: Vec3, normal: Vec3, t: f32, 
 
 /// `quantize` of each component, the three at once (SSE2, which every x86_64 CPU has):
 /// ×255, max with 0 (which also turns NaN into 0, as `NaN as u8` does), min with 255, then
-/// truncation — `quantize`'s result for every input (tested).
+/// truncation: `quantize`'s steps in its order, so its result (tested on every edge case).
 #[inline(always)]
 fn quantize3(v: Vec3) -> [u8; 3] {
     #[cfg(target_arch = "x86_64")]
