@@ -320,15 +320,15 @@ fn write_tile(band: &mut [Sample], w: usize, band_y0: u32, pass: &TilePass, grid
 /// Traces one tile's pass into a grid of its samples (the points traced before left unset,
 /// or, in a tile no ray can hit anything in, background like the rest).
 fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays, tracing: Tracing, cull: &TileCull, tp: &TilePass) -> Vec<Sample> {
+    // Packets only: the single rays trace every pixel, so that the two agreeing shows that
+    // no culled pixel would have hit.
+    if tracing == Tracing::Packets && !cull.may_hit((tp.x0, tp.y0, tp.x1, tp.y1)) {
+        let mut miss = Sample::UNSET;
+        store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
+        return vec![miss; tp.points()];
+    }
     let mut grid = vec![Sample::UNSET; tp.points()];
     match tracing {
-        // Packets only: the single rays trace every pixel, so that the two agreeing shows
-        // that no culled pixel would have hit.
-        Tracing::Packets if !cull.may_hit((tp.x0, tp.y0, tp.x1, tp.y1)) => {
-            let mut miss = Sample::UNSET;
-            store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
-            grid.fill(miss);
-        }
         // The lecture's other depth-t rules trace ray by ray (`intersect_with`).
         Tracing::Packets if settings.object_rays == ObjectRays::Unnormalized => {
             trace_packets(scene, settings, tp, rays, &points_to_trace(tp), &mut grid);
