@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use image::RgbImage;
-use tracelab_core::{CompiledScene, NodeId, NodeKind, NormalTransform, RenderSettings, Scene, TransformOp, View, check_scene, render_frame};
+use tracelab_core::{
+    CompiledScene, NodeId, NodeKind, NormalTransform, RenderSettings, Scene, TransformOp, View,
+    check_scene, render_frame,
+};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
@@ -33,11 +36,19 @@ impl Sweep {
 /// The names of an op's numbers, in the order `component` counts them.
 pub fn components(op: &TransformOp) -> Vec<String> {
     match op {
-        TransformOp::Scale(_) | TransformOp::Translate(_) => ["x", "y", "z"].map(String::from).to_vec(),
+        TransformOp::Scale(_) | TransformOp::Translate(_) => {
+            ["x", "y", "z"].map(String::from).to_vec()
+        }
         TransformOp::UniformScale(_) => vec!["factor".into()],
-        TransformOp::XRotate(_) | TransformOp::YRotate(_) | TransformOp::ZRotate(_) => vec!["degrees".into()],
-        TransformOp::Rotate { .. } => ["axis x", "axis y", "axis z", "degrees"].map(String::from).to_vec(),
-        TransformOp::Matrix(_) => (0..16).map(|i| format!("row {} col {}", i / 4, i % 4)).collect(),
+        TransformOp::XRotate(_) | TransformOp::YRotate(_) | TransformOp::ZRotate(_) => {
+            vec!["degrees".into()]
+        }
+        TransformOp::Rotate { .. } => ["axis x", "axis y", "axis z", "degrees"]
+            .map(String::from)
+            .to_vec(),
+        TransformOp::Matrix(_) => (0..16)
+            .map(|i| format!("row {} col {}", i / 4, i % 4))
+            .collect(),
     }
 }
 
@@ -46,7 +57,14 @@ pub fn with_component(op: &TransformOp, c: usize, v: f32) -> Option<TransformOp>
     let mut op = op.clone();
     match &mut op {
         TransformOp::Scale(x) | TransformOp::Translate(x) if c < 3 => x[c] = v,
-        TransformOp::UniformScale(x) | TransformOp::XRotate(x) | TransformOp::YRotate(x) | TransformOp::ZRotate(x) if c == 0 => *x = v,
+        TransformOp::UniformScale(x)
+        | TransformOp::XRotate(x)
+        | TransformOp::YRotate(x)
+        | TransformOp::ZRotate(x)
+            if c == 0 =>
+        {
+            *x = v
+        }
         TransformOp::Rotate { axis, .. } if c < 3 => axis[c] = v,
         TransformOp::Rotate { degrees, .. } if c == 3 => *degrees = v,
         // Written row by row; glam stores columns.
@@ -60,14 +78,29 @@ pub fn with_component(op: &TransformOp, c: usize, v: f32) -> Option<TransformOp>
 pub fn frame_scene(scene: &Scene, sweep: &Sweep, k: u32) -> Result<Scene, String> {
     let mut s = scene.clone();
     let v = sweep.value(k);
-    let node = s.graph.get_mut(sweep.node).ok_or_else(|| format!("node #{} does not exist", sweep.node.0))?;
+    let node = s
+        .graph
+        .get_mut(sweep.node)
+        .ok_or_else(|| format!("node #{} does not exist", sweep.node.0))?;
     let NodeKind::Transform(ops) = &mut node.kind else {
-        return Err(format!("node #{} is a {}, not a Transform", sweep.node.0, node.kind.name()));
+        return Err(format!(
+            "node #{} is a {}, not a Transform",
+            sweep.node.0,
+            node.kind.name()
+        ));
     };
     let count = ops.len();
-    let op = ops.get_mut(sweep.op).ok_or_else(|| format!("the Transform has {count} ops: there is no op {}", sweep.op))?;
-    *op = with_component(op, sweep.component, v)
-        .ok_or_else(|| format!("{} has {} numbers: there is no number {}", op.name(), components(op).len(), sweep.component))?;
+    let op = ops
+        .get_mut(sweep.op)
+        .ok_or_else(|| format!("the Transform has {count} ops: there is no op {}", sweep.op))?;
+    *op = with_component(op, sweep.component, v).ok_or_else(|| {
+        format!(
+            "{} has {} numbers: there is no number {}",
+            op.name(),
+            components(op).len(),
+            sweep.component
+        )
+    })?;
     if let Some(p) = check_scene(&s).into_iter().find(|p| !p.incomplete) {
         return Err(format!("frame {k} (value {v}): {}", p.message));
     }
@@ -78,13 +111,22 @@ pub fn frame_scene(scene: &Scene, sweep: &Sweep, k: u32) -> Result<Scene, String
 pub fn frame_image(scene: &Scene, settings: &RenderSettings, compare: bool) -> RgbImage {
     let compiled = CompiledScene::new(scene);
     let one = |rule: NormalTransform| {
-        let f = render_frame(&compiled, &RenderSettings { normal_transform: rule, ..*settings });
+        let f = render_frame(
+            &compiled,
+            &RenderSettings {
+                normal_transform: rule,
+                ..*settings
+            },
+        );
         RgbImage::from_raw(f.width, f.height, f.rgb8(View::Color, (0.0, 1.0))).expect("frame size")
     };
     if !compare {
         return one(settings.normal_transform);
     }
-    let (a, b) = (one(NormalTransform::Correct), one(NormalTransform::Incorrect));
+    let (a, b) = (
+        one(NormalTransform::Correct),
+        one(NormalTransform::Incorrect),
+    );
     let mut out = RgbImage::new(a.width() * 2, a.height());
     image::imageops::replace(&mut out, &a, 0, 0);
     image::imageops::replace(&mut out, &b, i64::from(a.width()), 0);
@@ -106,11 +148,27 @@ pub struct AnimationForm {
 
 impl AnimationForm {
     pub fn new(node: NodeId) -> Self {
-        AnimationForm { node, op: 0, component: 0, from: 0.0, to: 1.0, frames: 24, compare: false, folder: "animation".into() }
+        AnimationForm {
+            node,
+            op: 0,
+            component: 0,
+            from: 0.0,
+            to: 1.0,
+            frames: 24,
+            compare: false,
+            folder: "animation".into(),
+        }
     }
 
     pub fn sweep(&self) -> Sweep {
-        Sweep { node: self.node, op: self.op, component: self.component, from: self.from, to: self.to, frames: self.frames }
+        Sweep {
+            node: self.node,
+            op: self.op,
+            component: self.component,
+            from: self.from,
+            to: self.to,
+            frames: self.frames,
+        }
     }
 }
 
@@ -131,9 +189,14 @@ pub fn render_frames(
     mut progress: impl FnMut(u32),
 ) -> Result<Vec<RgbImage>, AnimateError> {
     if sweep.frames == 0 {
-        return Err(AnimateError::Refused("an animation needs at least one frame".into()));
+        return Err(AnimateError::Refused(
+            "an animation needs at least one frame".into(),
+        ));
     }
-    let scenes = (0..sweep.frames).map(|k| frame_scene(scene, sweep, k)).collect::<Result<Vec<_>, _>>().map_err(AnimateError::Refused)?;
+    let scenes = (0..sweep.frames)
+        .map(|k| frame_scene(scene, sweep, k))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(AnimateError::Refused)?;
     let mut out = Vec::with_capacity(scenes.len());
     for (k, s) in scenes.iter().enumerate() {
         if cancel.load(Ordering::Relaxed) {
@@ -146,20 +209,32 @@ pub fn render_frames(
 }
 
 /// Writes `dir/stem_0000.png …` and the animated `dir/stem.apng.png`; returns the files.
-pub fn write_frames(frames: &[RgbImage], dir: &Path, stem: &str, delay_ms: u16) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create folder: {e}", dir.display()))?;
+pub fn write_frames(
+    frames: &[RgbImage],
+    dir: &Path,
+    stem: &str,
+    delay_ms: u16,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("{}: cannot create folder: {e}", dir.display()))?;
     let mut written = Vec::new();
     for (k, f) in frames.iter().enumerate() {
         let p = dir.join(format!("{stem}_{k:04}.png"));
         let mut bytes = Vec::new();
-        f.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-            .map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
-        crate::io::write_atomic(&p, &bytes).map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+        f.write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
+        crate::io::write_atomic(&p, &bytes)
+            .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
         written.push(p);
     }
     let p = dir.join(format!("{stem}.apng.png"));
-    let bytes = apng(frames, delay_ms).map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
-    crate::io::write_atomic(&p, &bytes).map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+    let bytes =
+        apng(frames, delay_ms).map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
+    crate::io::write_atomic(&p, &bytes)
+        .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
     written.push(p);
     Ok(written)
 }
@@ -190,16 +265,33 @@ mod tests {
 
     #[test]
     fn values_run_from_first_to_last_inclusive() {
-        let s = Sweep { node: NodeId(0), op: 0, component: 0, from: 1.0, to: 3.0, frames: 5 };
-        assert_eq!((0..5).map(|k| s.value(k)).collect::<Vec<_>>(), [1.0, 1.5, 2.0, 2.5, 3.0]);
+        let s = Sweep {
+            node: NodeId(0),
+            op: 0,
+            component: 0,
+            from: 1.0,
+            to: 3.0,
+            frames: 5,
+        };
+        assert_eq!(
+            (0..5).map(|k| s.value(k)).collect::<Vec<_>>(),
+            [1.0, 1.5, 2.0, 2.5, 3.0]
+        );
     }
 
     #[test]
     fn a_component_is_one_number_of_the_op_as_written() {
-        let m = with_component(&TransformOp::Matrix(glam::Mat4::IDENTITY), 1, 0.5).expect("row 0 col 1");
+        let m = with_component(&TransformOp::Matrix(glam::Mat4::IDENTITY), 1, 0.5)
+            .expect("row 0 col 1");
         // Row 0, column 1: x' = x + 0.5 y.
-        assert_eq!(m.matrix().transform_point3(Vec3::Y), Vec3::new(0.5, 1.0, 0.0));
-        assert_eq!(with_component(&TransformOp::Scale(Vec3::ONE), 2, 4.0), Some(TransformOp::Scale(Vec3::new(1.0, 1.0, 4.0))));
+        assert_eq!(
+            m.matrix().transform_point3(Vec3::Y),
+            Vec3::new(0.5, 1.0, 0.0)
+        );
+        assert_eq!(
+            with_component(&TransformOp::Scale(Vec3::ONE), 2, 4.0),
+            Some(TransformOp::Scale(Vec3::new(1.0, 1.0, 4.0)))
+        );
         assert_eq!(with_component(&TransformOp::XRotate(0.0), 1, 4.0), None);
     }
 }

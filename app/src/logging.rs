@@ -25,7 +25,13 @@ pub fn init() {
         if record.target().starts_with("tracelab") {
             writeln!(buf, "tracelab: {}", record.args())
         } else {
-            writeln!(buf, "{}: {}: {}", record.target(), record.level(), record.args())
+            writeln!(
+                buf,
+                "{}: {}: {}",
+                record.target(),
+                record.level(),
+                record.args()
+            )
         }
     });
     let _ = b.try_init();

@@ -9,7 +9,9 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use tracelab_core::render::{NormalGap, normal_rule_gap, render_coarse, render_progressive};
-use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame};
+use tracelab_core::{
+    CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame,
+};
 
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
 #[derive(Clone, Debug)]
@@ -154,7 +156,9 @@ impl RenderWorker {
     pub fn is_idle(&self) -> bool {
         self.with_published(|p| {
             // The normal-rule gap is part of what is shown (the toolbar), so idle waits for it.
-            p.is_some_and(|p| p.job.request == self.requests && p.full.is_some() && p.normal_gap.is_some())
+            p.is_some_and(|p| {
+                p.job.request == self.requests && p.full.is_some() && p.normal_gap.is_some()
+            })
         })
     }
 
@@ -201,11 +205,8 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             .collect();
         // Per frame: passes done and passes planned (a quick coarse pass skips the passes
         // before the full one, and the flip view's two frames may not skip the same).
-        let counts: Vec<[std::sync::atomic::AtomicUsize; 2]> = job
-            .modes
-            .iter()
-            .map(|_| Default::default())
-            .collect();
+        let counts: Vec<[std::sync::atomic::AtomicUsize; 2]> =
+            job.modes.iter().map(|_| Default::default()).collect();
         {
             // The UI keeps showing its previous image until this one has its first pass.
             let mut p = shared
@@ -279,12 +280,22 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
             (0..frames.len()).all(render_one)
         };
         let repaint = || {
-            if let Some(f) = shared.repaint.lock().unwrap_or_else(PoisonError::into_inner).as_ref() {
+            if let Some(f) = shared
+                .repaint
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .as_ref()
+            {
                 f();
             }
         };
         if ok && let Ok(gap) = normal_rule_gap(&compiled, &job.settings, &cancel) {
-            if let Some(p) = shared.published.lock().unwrap_or_else(PoisonError::into_inner).as_mut() {
+            if let Some(p) = shared
+                .published
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .as_mut()
+            {
                 if p.job.request == job.request {
                     p.normal_gap = Some(gap);
                 }
@@ -318,12 +329,24 @@ mod tests {
     #[test]
     fn a_render_is_full_when_every_frame_has_done_its_own_passes() {
         assert_eq!(passes_of(&[(0, 0), (0, 0)]), (0, 0, false));
-        assert_eq!(passes_of(&[(1, 4), (0, 0)]), (0, 4, false), "one frame yet to report");
+        assert_eq!(
+            passes_of(&[(1, 4), (0, 0)]),
+            (0, 4, false),
+            "one frame yet to report"
+        );
         assert_eq!(passes_of(&[(2, 3), (1, 4)]), (1, 4, false));
-        assert_eq!(passes_of(&[(3, 3), (3, 4)]), (3, 4, false), "the skipper done, the other not");
+        assert_eq!(
+            passes_of(&[(3, 3), (3, 4)]),
+            (3, 4, false),
+            "the skipper done, the other not"
+        );
         assert_eq!(passes_of(&[(3, 3), (4, 4)]), (4, 4, true));
         assert_eq!(passes_of(&[(3, 3)]), (3, 3, true));
-        assert_eq!(passes_of(&[(2, 2), (2, 2)]), (2, 2, true), "coarse passes only");
+        assert_eq!(
+            passes_of(&[(2, 2), (2, 2)]),
+            (2, 2, true),
+            "coarse passes only"
+        );
     }
 
     fn scene() -> Arc<Scene> {
@@ -406,7 +429,10 @@ mod tests {
         assert!(!w.is_idle(), "idle before the Incorrect render ran");
         wait_idle(&w);
         w.with_published(|p| {
-            assert_eq!(p.expect("published").job.modes, [NormalTransform::Incorrect]);
+            assert_eq!(
+                p.expect("published").job.modes,
+                [NormalTransform::Incorrect]
+            );
         });
     }
 }

@@ -177,15 +177,25 @@ fn a3(v: Vec3) -> [f32; 3] {
 }
 
 fn ray(r: &tracelab_core::geometry::Ray) -> RayReport {
-    RayReport { origin: a3(r.origin), direction: a3(r.direction) }
+    RayReport {
+        origin: a3(r.origin),
+        direction: a3(r.direction),
+    }
 }
 
 fn rows3(m: DMat3) -> [[f64; 3]; 3] {
-    [m.row(0).to_array(), m.row(1).to_array(), m.row(2).to_array()]
+    [
+        m.row(0).to_array(),
+        m.row(1).to_array(),
+        m.row(2).to_array(),
+    ]
 }
 
 fn affine(m: DMat4) -> AffineReport {
-    AffineReport { linear: rows3(DMat3::from_mat4(m)), translation: m.w_axis.truncate().to_array() }
+    AffineReport {
+        linear: rows3(DMat3::from_mat4(m)),
+        translation: m.w_axis.truncate().to_array(),
+    }
 }
 
 pub fn similitude_report(t: &SimilitudeTest) -> SimilitudeReport {
@@ -249,7 +259,11 @@ pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> 
             if let Some(m) = s.transform {
                 world_from_object *= m;
             }
-            StepReport { node: node(scene, s.node), transform: s.transform.map(transform_report), ray: ray(&s.ray) }
+            StepReport {
+                node: node(scene, s.node),
+                transform: s.transform.map(transform_report),
+                ray: ray(&s.ray),
+            }
         })
         .collect();
     let object_direction_length = h.object_ray.direction.length();
@@ -261,7 +275,11 @@ pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> 
             world: h.t,
             object: h.t_object,
             used: h.t_used,
-            used_is: if h.object_rays == ObjectRays::NormalizedNoRescale && h.t_used != h.t { "object" } else { "world" },
+            used_is: if h.object_rays == ObjectRays::NormalizedNoRescale && h.t_used != h.t {
+                "object"
+            } else {
+                "world"
+            },
             object_direction_length,
         },
         traced_ray: ray(&h.traced_ray),
@@ -283,7 +301,11 @@ pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> 
                 .shade
                 .lights
                 .iter()
-                .map(|l| LightReport { direction: a3(l.l), l_dot_n: l.l_dot_n, contribution: a3(l.contribution) })
+                .map(|l| LightReport {
+                    direction: a3(l.l),
+                    l_dot_n: l.l_dot_n,
+                    contribution: a3(l.contribution),
+                })
                 .collect(),
             color: a3(h.shade.color),
         },
@@ -296,14 +318,20 @@ pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) 
     PixelReport {
         schema: SCHEMA,
         size: [settings.width, settings.height],
-        pixel: PixelAt { x: story.x, row: story.row },
+        pixel: PixelAt {
+            x: story.x,
+            row: story.row,
+        },
         settings: SettingsReport {
             object_rays: object_rays_name(settings.object_rays),
             normal_transform: normal_rule_name(settings.normal_transform),
             shade_back: settings.shade_back,
         },
         world_ray: ray(&story.world_ray),
-        hit: story.hit.as_ref().map(|h| hit_report(scene, h, story.normal_transform)),
+        hit: story
+            .hit
+            .as_ref()
+            .map(|h| hit_report(scene, h, story.normal_transform)),
         background: a3(story.background),
         color: a3(color),
         rgb8: [quantize(color.x), quantize(color.y), quantize(color.z)],
@@ -316,12 +344,27 @@ fn v3(v: [f32; 3]) -> String {
 
 fn d3(v: [f64; 3]) -> String {
     // + 0.0 turns −0 into 0: a sign on a zero only distracts.
-    format!("{:>10.5} {:>10.5} {:>10.5}", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0)
+    format!(
+        "{:>10.5} {:>10.5} {:>10.5}",
+        v[0] + 0.0,
+        v[1] + 0.0,
+        v[2] + 0.0
+    )
 }
 
-fn matrix_lines(out: &mut Vec<String>, indent: &str, name: &str, linear: &[[f64; 3]; 3], translation: Option<[f64; 3]>) {
+fn matrix_lines(
+    out: &mut Vec<String>,
+    indent: &str,
+    name: &str,
+    linear: &[[f64; 3]; 3],
+    translation: Option<[f64; 3]>,
+) {
     for (i, r) in linear.iter().enumerate() {
-        let head = if i == 0 { format!("{name:<9}") } else { " ".repeat(9) };
+        let head = if i == 0 {
+            format!("{name:<9}")
+        } else {
+            " ".repeat(9)
+        };
         let t = match translation {
             Some(t) => format!(" | {:>10.5}", t[i]),
             None => String::new(),
@@ -334,7 +377,13 @@ fn matrix_lines(out: &mut Vec<String>, indent: &str, name: &str, linear: &[[f64;
 pub fn transform_lines(indent: &str, t: &TransformReport) -> Vec<String> {
     let mut out = Vec::new();
     matrix_lines(&mut out, indent, "M", &t.m.linear, Some(t.m.translation));
-    matrix_lines(&mut out, indent, "M⁻¹", &t.m_inverse.linear, Some(t.m_inverse.translation));
+    matrix_lines(
+        &mut out,
+        indent,
+        "M⁻¹",
+        &t.m_inverse.linear,
+        Some(t.m_inverse.translation),
+    );
     matrix_lines(&mut out, indent, "(M⁻¹)ᵀ", &t.m_inverse_transpose, None);
     out.push(format!("{indent}{}", t.similitude.summary));
     out
@@ -353,9 +402,16 @@ pub fn report_text(r: &PixelReport) -> String {
         r.settings.normal_transform,
         if r.settings.shade_back { "; shade back" } else { "" }
     ));
-    out.push(format!("world ray: origin {} direction {}", v3(r.world_ray.origin), v3(r.world_ray.direction)));
+    out.push(format!(
+        "world ray: origin {} direction {}",
+        v3(r.world_ray.origin),
+        v3(r.world_ray.direction)
+    ));
     let Some(h) = &r.hit else {
-        out.push(format!("missed every object: background {}", v3(r.background)));
+        out.push(format!(
+            "missed every object: background {}",
+            v3(r.background)
+        ));
         out.push(format!("colour {} -> bytes {:?}", v3(r.color), r.rgb8));
         return out.join("\n") + "\n";
     };
@@ -366,7 +422,11 @@ pub fn report_text(r: &PixelReport) -> String {
         if let Some(t) = &s.transform {
             out.extend(transform_lines("      ", t));
         }
-        out.push(format!("      ray: origin {} direction {}", v3(s.ray.origin), v3(s.ray.direction)));
+        out.push(format!(
+            "      ray: origin {} direction {}",
+            v3(s.ray.origin),
+            v3(s.ray.direction)
+        ));
     }
     out.push("world from object (composed):".into());
     out.extend(transform_lines("      ", &h.world_from_object));
@@ -374,12 +434,29 @@ pub fn report_text(r: &PixelReport) -> String {
         "t: world {:.6}, object {:.6} (|M⁻¹d| = {:.6}); the renderer kept {:.6}, the {} t",
         h.t.world, h.t.object, h.t.object_direction_length, h.t.used, h.t.used_is
     ));
-    out.push(format!("traced ray (object space): origin {} direction {}", v3(h.traced_ray.origin), v3(h.traced_ray.direction)));
-    out.push(format!("hit point: world {} object {}", v3(h.point_world), v3(h.point_object)));
+    out.push(format!(
+        "traced ray (object space): origin {} direction {}",
+        v3(h.traced_ray.origin),
+        v3(h.traced_ray.direction)
+    ));
+    out.push(format!(
+        "hit point: world {} object {}",
+        v3(h.point_world),
+        v3(h.point_object)
+    ));
     out.push(format!("normal: object {}", v3(h.normal.object)));
-    out.push(format!("        world by (M⁻¹)ᵀ {}", v3(h.normal.world_correct)));
-    out.push(format!("        world by M      {}", v3(h.normal.world_incorrect)));
-    out.push(format!("        angle between them {:.4}°", h.normal.angle_degrees));
+    out.push(format!(
+        "        world by (M⁻¹)ᵀ {}",
+        v3(h.normal.world_correct)
+    ));
+    out.push(format!(
+        "        world by M      {}",
+        v3(h.normal.world_incorrect)
+    ));
+    out.push(format!(
+        "        angle between them {:.4}°",
+        h.normal.angle_degrees
+    ));
     let sh = &h.shading;
     out.push(format!(
         "shading by the {} rule{}: k_d {}",
@@ -389,9 +466,17 @@ pub fn report_text(r: &PixelReport) -> String {
     ));
     out.push(format!("  ambient·k_d            {}", v3(sh.ambient)));
     for (i, l) in sh.lights.iter().enumerate() {
-        out.push(format!("  light {i}: L·N = {:.5}  {}", l.l_dot_n, v3(l.contribution)));
+        out.push(format!(
+            "  light {i}: L·N = {:.5}  {}",
+            l.l_dot_n,
+            v3(l.contribution)
+        ));
     }
-    out.push(format!("  sum                    {} -> bytes {:?}", v3(r.color), r.rgb8));
+    out.push(format!(
+        "  sum                    {} -> bytes {:?}",
+        v3(r.color),
+        r.rgb8
+    ));
     out.join("\n") + "\n"
 }
 
@@ -400,20 +485,40 @@ pub fn one_line(r: &PixelReport) -> String {
     let Some(h) = &r.hit else {
         return format!("the ray misses everything: background {}", v3(r.background));
     };
-    let kept = if h.t.used_is == "object" { format!(" (kept the object-space t {:.4})", h.t.used) } else { String::new() };
-    let n = if h.shading.normal_rule == "correct" { h.normal.world_correct } else { h.normal.world_incorrect };
-    let rule = if h.shading.normal_rule == "correct" { "(M⁻¹)ᵀ" } else { "M" };
+    let kept = if h.t.used_is == "object" {
+        format!(" (kept the object-space t {:.4})", h.t.used)
+    } else {
+        String::new()
+    };
+    let n = if h.shading.normal_rule == "correct" {
+        h.normal.world_correct
+    } else {
+        h.normal.world_incorrect
+    };
+    let rule = if h.shading.normal_rule == "correct" {
+        "(M⁻¹)ᵀ"
+    } else {
+        "M"
+    };
     let other = if h.normal.angle_degrees > 0.01 {
         format!(", {:.2}° from the other rule's", h.normal.angle_degrees)
     } else {
         String::new()
     };
-    format!("{} at t = {:.4}{kept}, normal by {rule} {}{other}", h.node.label, h.t.world, v3(n))
+    format!(
+        "{} at t = {:.4}{kept}, normal by {rule} {}{other}",
+        h.node.label,
+        h.t.world,
+        v3(n)
+    )
 }
 
 /// For a node of the scene: its own similitude test when it is a Transform, and that of the
 /// world-from-object chain down to it (every Transform above it, and itself), in f64.
-pub fn node_similitudes(scene: &Scene, id: tracelab_core::NodeId) -> (Option<SimilitudeTest>, SimilitudeTest) {
+pub fn node_similitudes(
+    scene: &Scene,
+    id: tracelab_core::NodeId,
+) -> (Option<SimilitudeTest>, SimilitudeTest) {
     use tracelab_core::NodeKind;
     use tracelab_core::scene::validate::compose_f64;
     let g = &scene.graph;

@@ -7,7 +7,11 @@ use std::process::{Command, Output};
 use image::AnimationDecoder;
 
 fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab")).args(args).current_dir(dir).output().expect("run tracelab")
+    Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run tracelab")
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -27,13 +31,28 @@ Group { numObjects 1 MaterialIndex 0
 ";
 
 fn read(p: &Path) -> image::RgbImage {
-    image::open(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgb8()
+    image::open(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .to_rgb8()
 }
 
 /// The Transform's node id, as `tracelab inspect --json` reports it on the path.
 fn transform_id(dir: &Path) -> String {
     std::fs::write(dir.join("probe.txt"), SCENE.replace("VALUE", "0")).expect("write");
-    let o = tracelab(&["inspect", "probe.txt", "--size", "32", "24", "--pixel", "16", "12", "--json"], dir);
+    let o = tracelab(
+        &[
+            "inspect",
+            "probe.txt",
+            "--size",
+            "32",
+            "24",
+            "--pixel",
+            "16",
+            "12",
+            "--json",
+        ],
+        dir,
+    );
     assert!(o.status.success());
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
     let step = &j["hit"]["path"][1];
@@ -47,7 +66,27 @@ fn every_frame_is_the_single_render_of_its_value_and_the_apng_holds_them() {
     let id = transform_id(&dir);
     std::fs::write(dir.join("anim.txt"), SCENE.replace("VALUE", "0")).expect("write");
     let o = tracelab(
-        &["animate", "anim.txt", "--size", "32", "24", "--node", &id, "--op", "0", "--component", "0", "--from", "-1", "--to", "1", "--frames", "5", "--out", "out"],
+        &[
+            "animate",
+            "anim.txt",
+            "--size",
+            "32",
+            "24",
+            "--node",
+            &id,
+            "--op",
+            "0",
+            "--component",
+            "0",
+            "--from",
+            "-1",
+            "--to",
+            "1",
+            "--frames",
+            "5",
+            "--out",
+            "out",
+        ],
         &dir,
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -56,19 +95,38 @@ fn every_frame_is_the_single_render_of_its_value_and_the_apng_holds_them() {
         let scene = format!("v{k}.txt");
         std::fs::write(dir.join(&scene), SCENE.replace("VALUE", value)).expect("write");
         let single = format!("single{k}.png");
-        assert!(tracelab(&["render", &scene, "--size", "32", "24", "--output", &single], &dir).status.success());
+        assert!(
+            tracelab(
+                &["render", &scene, "--size", "32", "24", "--output", &single],
+                &dir
+            )
+            .status
+            .success()
+        );
         let frame = read(&dir.join(format!("out/frame_{k:04}.png")));
-        assert_eq!(frame, read(&dir.join(&single)), "frame {k} (Translate {value})");
+        assert_eq!(
+            frame,
+            read(&dir.join(&single)),
+            "frame {k} (Translate {value})"
+        );
         seq.push(frame);
     }
     assert_ne!(seq[0], seq[4], "the sphere moved");
     let file = std::fs::File::open(dir.join("out/frame.apng.png")).expect("apng");
     let decoder = image::codecs::png::PngDecoder::new(std::io::BufReader::new(file)).expect("png");
     assert!(decoder.is_apng().expect("apng header"));
-    let frames = decoder.apng().expect("apng").into_frames().collect_frames().expect("frames");
+    let frames = decoder
+        .apng()
+        .expect("apng")
+        .into_frames()
+        .collect_frames()
+        .expect("frames");
     assert_eq!(frames.len(), 5);
     for (f, s) in frames.iter().zip(&seq) {
-        assert_eq!(&image::DynamicImage::ImageRgba8(f.buffer().clone()).to_rgb8(), s);
+        assert_eq!(
+            &image::DynamicImage::ImageRgba8(f.buffer().clone()).to_rgb8(),
+            s
+        );
     }
 }
 
@@ -79,15 +137,60 @@ fn a_compare_animation_puts_both_normal_rules_side_by_side() {
     std::fs::write(dir.join("anim.txt"), SCENE.replace("VALUE", "0")).expect("write");
     // Op 1, component 1: Scale y, swept from 0.6 (the file's value) to 1.5.
     let o = tracelab(
-        &["animate", "anim.txt", "--size", "32", "24", "--node", &id, "--op", "1", "--component", "1", "--from", "0.6", "--to", "1.5", "--frames", "2", "--compare", "--out", "out"],
+        &[
+            "animate",
+            "anim.txt",
+            "--size",
+            "32",
+            "24",
+            "--node",
+            &id,
+            "--op",
+            "1",
+            "--component",
+            "1",
+            "--from",
+            "0.6",
+            "--to",
+            "1.5",
+            "--frames",
+            "2",
+            "--compare",
+            "--out",
+            "out",
+        ],
         &dir,
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let frame = read(&dir.join("out/frame_0000.png"));
     assert_eq!(frame.dimensions(), (64, 24));
     std::fs::write(dir.join("s.txt"), SCENE.replace("VALUE", "0")).expect("write");
-    assert!(tracelab(&["render", "s.txt", "--size", "32", "24", "--output", "c.png"], &dir).status.success());
-    assert!(tracelab(&["render", "s.txt", "--size", "32", "24", "--output", "i.png", "--normal-transform", "incorrect"], &dir).status.success());
+    assert!(
+        tracelab(
+            &["render", "s.txt", "--size", "32", "24", "--output", "c.png"],
+            &dir
+        )
+        .status
+        .success()
+    );
+    assert!(
+        tracelab(
+            &[
+                "render",
+                "s.txt",
+                "--size",
+                "32",
+                "24",
+                "--output",
+                "i.png",
+                "--normal-transform",
+                "incorrect"
+            ],
+            &dir
+        )
+        .status
+        .success()
+    );
     let left = image::imageops::crop_imm(&frame, 0, 0, 32, 24).to_image();
     let right = image::imageops::crop_imm(&frame, 32, 0, 32, 24).to_image();
     assert_eq!(left, read(&dir.join("c.png")));
@@ -102,14 +205,36 @@ fn a_sweep_through_a_refused_value_writes_nothing_and_says_which_frame() {
     std::fs::write(dir.join("anim.txt"), SCENE.replace("VALUE", "0")).expect("write");
     // Scale x from 1 to −1 passes through 0 at the middle frame: a flat, singular transform.
     let o = tracelab(
-        &["animate", "anim.txt", "--node", &id, "--op", "1", "--component", "0", "--from", "1", "--to", "-1", "--frames", "3", "--out", "out"],
+        &[
+            "animate",
+            "anim.txt",
+            "--node",
+            &id,
+            "--op",
+            "1",
+            "--component",
+            "0",
+            "--from",
+            "1",
+            "--to",
+            "-1",
+            "--frames",
+            "3",
+            "--out",
+            "out",
+        ],
         &dir,
     );
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("frame 1 (value 0)"), "{err}");
     assert!(!dir.join("out").exists(), "nothing written");
-    let o = tracelab(&["animate", "anim.txt", "--node", "999", "--from", "0", "--to", "1", "--out", "out"], &dir);
+    let o = tracelab(
+        &[
+            "animate", "anim.txt", "--node", "999", "--from", "0", "--to", "1", "--out", "out",
+        ],
+        &dir,
+    );
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("node #999 does not exist"));
 }

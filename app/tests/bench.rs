@@ -137,7 +137,10 @@ fn bench_progressive_reports_coarse_before_full() {
     assert!(coarse > 0.0 && coarse <= full, "{last}");
     // Each pass's own time by its scale, the first being the coarse image's; this tiny scene's
     // quick coarse passes go straight to the full one in some runs or all.
-    let passes = out.lines().find_map(|l| l.strip_prefix("passes: ")).expect("a passes line");
+    let passes = out
+        .lines()
+        .find_map(|l| l.strip_prefix("passes: "))
+        .expect("a passes line");
     let each: Vec<(&str, f64)> = passes
         .split(" ms each")
         .next()
@@ -145,38 +148,87 @@ fn bench_progressive_reports_coarse_before_full() {
         .split(" + ")
         .map(|p| {
             let (scale, rest) = p.split_once("× ").expect("scale× time");
-            (scale, rest.split(' ').next().and_then(|t| t.parse().ok()).expect("a number"))
+            (
+                scale,
+                rest.split(' ')
+                    .next()
+                    .and_then(|t| t.parse().ok())
+                    .expect("a number"),
+            )
         })
         .collect();
     let scales: Vec<&str> = each.iter().map(|e| e.0).collect();
-    assert!([&["8", "4", "2", "1"][..], &["8", "4", "1"], &["8", "1"]].contains(&&scales[..]), "{passes}");
-    assert!(each.iter().all(|e| e.1 >= 0.0) && (each[0].1 - coarse).abs() < 0.006, "{passes} / {last}");
+    assert!(
+        [&["8", "4", "2", "1"][..], &["8", "4", "1"], &["8", "1"]].contains(&&scales[..]),
+        "{passes}"
+    );
+    assert!(
+        each.iter().all(|e| e.1 >= 0.0) && (each[0].1 - coarse).abs() < 0.006,
+        "{passes} / {last}"
+    );
 }
 
 #[test]
 fn bench_progressive_times_single_rays_when_asked() {
     let d = quad_scene("progressive-single");
-    for (flag, says) in [(None, "in packets of 8"), (Some("--single-rays"), "one at a time")] {
-        let mut args = vec!["bench-progressive", "quad.txt", "--size", "32", "32", "--repeat", "1"];
+    for (flag, says) in [
+        (None, "in packets of 8"),
+        (Some("--single-rays"), "one at a time"),
+    ] {
+        let mut args = vec![
+            "bench-progressive",
+            "quad.txt",
+            "--size",
+            "32",
+            "32",
+            "--repeat",
+            "1",
+        ];
         args.extend(flag);
         let o = tracelab(&args, &d);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let out = String::from_utf8_lossy(&o.stdout);
         assert!(out.contains(&format!("primary rays {says}")), "{out}");
-        assert!(out.lines().last().unwrap_or_default().starts_with("PROGRESSIVE "), "{out}");
+        assert!(
+            out.lines()
+                .last()
+                .unwrap_or_default()
+                .starts_with("PROGRESSIVE "),
+            "{out}"
+        );
     }
 }
 
 #[test]
 fn bench_progressive_times_a_camera_orbit_per_step() {
     let d = quad_scene("orbit");
-    let o = tracelab(&["bench-progressive", "quad.txt", "--size", "64", "64", "--repeat", "1", "--orbit", "6"], &d);
+    let o = tracelab(
+        &[
+            "bench-progressive",
+            "quad.txt",
+            "--size",
+            "64",
+            "64",
+            "--repeat",
+            "1",
+            "--orbit",
+            "6",
+        ],
+        &d,
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
     let last = out.lines().last().unwrap_or_default();
     assert!(last.starts_with("ORBIT steps=6 "), "last line: {last:?}");
-    let (first, coarse, full) = (field(last, "first_ms"), field(last, "coarse_ms"), field(last, "full_ms"));
-    assert!(first > 0.0 && first <= coarse && coarse <= full * 1.5 + 1.0, "{last}");
+    let (first, coarse, full) = (
+        field(last, "first_ms"),
+        field(last, "coarse_ms"),
+        field(last, "full_ms"),
+    );
+    assert!(
+        first > 0.0 && first <= coarse && coarse <= full * 1.5 + 1.0,
+        "{last}"
+    );
     assert!(field(last, "max_first_ms") >= first);
 }
 

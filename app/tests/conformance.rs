@@ -6,10 +6,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-
 fn shared() -> PathBuf {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/mit6837");
-    assert!(p.join("commands.txt").is_file(), "{} is missing: this test needs ../shared beside the checkout", p.display());
+    assert!(
+        p.join("commands.txt").is_file(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        p.display()
+    );
     p
 }
 
@@ -23,10 +26,18 @@ fn copy_dir(from: &Path, to: &Path) {
 
 /// (% of pixels within tolerance, largest channel difference)
 fn compare(out: &Path, reference: &Path) -> Result<(f64, u8), String> {
-    let a = image::open(out).map_err(|e| format!("{}: {e}", out.display()))?.to_rgb8();
-    let b = image::open(reference).map_err(|e| format!("{}: {e}", reference.display()))?.to_rgb8();
+    let a = image::open(out)
+        .map_err(|e| format!("{}: {e}", out.display()))?
+        .to_rgb8();
+    let b = image::open(reference)
+        .map_err(|e| format!("{}: {e}", reference.display()))?
+        .to_rgb8();
     if a.dimensions() != b.dimensions() {
-        return Err(format!("size {:?} vs reference {:?}", a.dimensions(), b.dimensions()));
+        return Err(format!(
+            "size {:?} vs reference {:?}",
+            a.dimensions(),
+            b.dimensions()
+        ));
     }
     let mut within = 0usize;
     let mut worst = 0u8;
@@ -37,7 +48,10 @@ fn compare(out: &Path, reference: &Path) -> Result<(f64, u8), String> {
             within += 1;
         }
     }
-    Ok((100.0 * within as f64 / (a.width() * a.height()) as f64, worst))
+    Ok((
+        100.0 * within as f64 / (a.width() * a.height()) as f64,
+        worst,
+    ))
 }
 
 #[test]
@@ -56,9 +70,17 @@ fn every_course_command_line_matches_the_reference_images() {
         let mut words = line.split_whitespace();
         assert_eq!(words.next(), Some("raytracer"), "unexpected line {line}");
         let args: Vec<&str> = words.collect();
-        let out = Command::new(exe).args(&args).current_dir(&dir).output().expect("run tracelab");
+        let out = Command::new(exe)
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .expect("run tracelab");
         if !out.status.success() {
-            failures.push(format!("{line}: exit {:?}: {}", out.status.code(), String::from_utf8_lossy(&out.stderr)));
+            failures.push(format!(
+                "{line}: exit {:?}: {}",
+                out.status.code(),
+                String::from_utf8_lossy(&out.stderr)
+            ));
             continue;
         }
         // Every image the line writes: the value after -output and -normals, the third after -depth.
@@ -74,7 +96,10 @@ fn every_course_command_line_matches_the_reference_images() {
             match compare(&dir.join(img), &shared.join("reference").join(img)) {
                 Ok((pct, worst)) => {
                     let pass = pct >= 99.0;
-                    rows.push(format!("{img:<24} {pct:>8.2}% {worst:>6}  {}", if pass { "pass" } else { "FAIL" }));
+                    rows.push(format!(
+                        "{img:<24} {pct:>8.2}% {worst:>6}  {}",
+                        if pass { "pass" } else { "FAIL" }
+                    ));
                     if !pass {
                         failures.push(format!("{img}: {pct:.2}% within 8/255"));
                     }
@@ -96,6 +121,10 @@ fn every_course_command_line_matches_the_reference_images() {
         elapsed.as_secs_f64()
     );
     let _ = std::fs::remove_dir_all(&dir);
-    assert!(failures.is_empty(), "conformance failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "conformance failures:\n{}",
+        failures.join("\n")
+    );
     assert_eq!(rows.len(), 44, "expected 44 reference images");
 }

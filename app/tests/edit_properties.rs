@@ -7,18 +7,21 @@
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
-use tracelab::document::edit::Edit;
 use tracelab::document::Document;
+use tracelab::document::edit::Edit;
 use tracelab_core::{
-    Background, Camera, CsgOp, Light, Material, MeshCache, MeshSlot, NodeId, NodeKind, RenderSettings, Scene,
-    TransformOp, check_scene, compile, parse_scene, render_frame, write_scene,
+    Background, Camera, CsgOp, Light, Material, MeshCache, MeshSlot, NodeId, NodeKind,
+    RenderSettings, Scene, TransformOp, check_scene, compile, parse_scene, render_frame,
+    write_scene,
 };
 
 /// xorshift64*: small, seeded, repeatable.
 struct Rng(u64);
 
 /// What a user can type into a field.
-const TYPED: &[&str] = &["0", "-0", "1e30", "-1e30", "1e39", "nan", "inf", "-inf", "", DIGITS_400, "letters"];
+const TYPED: &[&str] = &[
+    "0", "-0", "1e30", "-1e30", "1e39", "nan", "inf", "-inf", "", DIGITS_400, "letters",
+];
 const DIGITS_400: &str = "7777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777\
 7777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777\
 7777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777777\
@@ -118,7 +121,11 @@ fn random_kind(r: &mut Rng) -> NodeKind {
 fn random_material(r: &mut Rng) -> Material {
     let mut m = Material::diffuse(r.v());
     if r.below(4) == 0 {
-        let name = if r.below(2) == 0 { "specularColor".to_string() } else { r.word() };
+        let name = if r.below(2) == 0 {
+            "specularColor".to_string()
+        } else {
+            r.word()
+        };
         m.extra.push((name, vec![r.f(), r.f(), r.f()]));
     }
     m
@@ -137,11 +144,25 @@ fn random_node(r: &mut Rng, d: &Document) -> NodeId {
 fn random_camera(r: &mut Rng) -> Camera {
     // Now and then up parallel to the direction.
     let direction = r.v();
-    let up = if r.below(6) == 0 { direction * 2.0 } else { r.v() };
-    if r.below(2) == 0 {
-        Camera::Orthographic { center: r.v(), direction, up, size: r.f() * 5.0 }
+    let up = if r.below(6) == 0 {
+        direction * 2.0
     } else {
-        Camera::Perspective { center: r.v(), direction, up, angle: r.f() * 180.0 }
+        r.v()
+    };
+    if r.below(2) == 0 {
+        Camera::Orthographic {
+            center: r.v(),
+            direction,
+            up,
+            size: r.f() * 5.0,
+        }
+    } else {
+        Camera::Perspective {
+            center: r.v(),
+            direction,
+            up,
+            angle: r.f() * 180.0,
+        }
     }
 }
 
@@ -211,7 +232,11 @@ fn random_edit(r: &mut Rng, d: &Document) -> Edit {
 const SAVE_AS: &str = "edit-property-never-written.txt";
 
 fn render(s: &Scene) -> Vec<[u8; 3]> {
-    render_frame(&compile(s), &RenderSettings::new(4, 4)).samples.iter().map(|p| p.color).collect()
+    render_frame(&compile(s), &RenderSettings::new(4, 4))
+        .samples
+        .iter()
+        .map(|p| p.color)
+        .collect()
 }
 
 /// What Save would do now: write text that reads back as this document (checked here
@@ -221,25 +246,57 @@ fn check_save(d: &mut Document, seed: u64, step: usize) {
     let (s, t) = (seed, step);
     match d.text_for(Path::new(SAVE_AS)) {
         Ok(text) => {
-            let back = parse_scene(text.as_bytes(), SAVE_AS, Some(Path::new(".")), &mut MeshCache::new());
+            let back = parse_scene(
+                text.as_bytes(),
+                SAVE_AS,
+                Some(Path::new(".")),
+                &mut MeshCache::new(),
+            );
             let Some(read) = back.scene else {
-                panic!("seed {s} step {t}: Save would write a file that does not open:\n{}\n{text}", back.diagnostics)
+                panic!(
+                    "seed {s} step {t}: Save would write a file that does not open:\n{}\n{text}",
+                    back.diagnostics
+                )
             };
-            assert_eq!(d.scene.reads_back_as(&read), Ok(()), "seed {s} step {t}:\n{text}");
-            assert_eq!(write_scene(&read), text, "seed {s} step {t}: writing is not canonical");
-            assert_eq!(render(&read), render(&d.scene), "seed {s} step {t}: renders differently:\n{text}");
+            assert_eq!(
+                d.scene.reads_back_as(&read),
+                Ok(()),
+                "seed {s} step {t}:\n{text}"
+            );
+            assert_eq!(
+                write_scene(&read),
+                text,
+                "seed {s} step {t}: writing is not canonical"
+            );
+            assert_eq!(
+                render(&read),
+                render(&d.scene),
+                "seed {s} step {t}: renders differently:\n{text}"
+            );
         }
         Err(why) => {
-            let incomplete: Vec<_> = check_scene(&d.scene).into_iter().filter(|p| p.incomplete).collect();
-            assert!(!incomplete.is_empty(), "seed {s} step {t}: Save refuses a complete document: {why}");
-            assert!(why.to_string().contains(&incomplete[0].message), "seed {s} step {t}: {why}");
+            let incomplete: Vec<_> = check_scene(&d.scene)
+                .into_iter()
+                .filter(|p| p.incomplete)
+                .collect();
+            assert!(
+                !incomplete.is_empty(),
+                "seed {s} step {t}: Save refuses a complete document: {why}"
+            );
+            assert!(
+                why.to_string().contains(&incomplete[0].message),
+                "seed {s} step {t}: {why}"
+            );
         }
     }
 }
 
 /// Seeds: 2000 (about half a minute here); `TRACELAB_EDIT_SEEDS` asks for more or fewer.
 fn seeds() -> u64 {
-    std::env::var("TRACELAB_EDIT_SEEDS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000)
+    std::env::var("TRACELAB_EDIT_SEEDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(2000)
 }
 
 #[test]
@@ -266,7 +323,10 @@ fn random_edits_are_refused_or_saved_faithfully_and_full_undo_restores_the_docum
                         applied += 1;
                     } else {
                         refused_all += 1;
-                        assert_eq!(d.scene, before, "seed {seed} step {step}: a refused {e:?} changed the document");
+                        assert_eq!(
+                            d.scene, before,
+                            "seed {seed} step {step}: a refused {e:?} changed the document"
+                        );
                     }
                 }
             }
@@ -276,11 +336,20 @@ fn random_edits_are_refused_or_saved_faithfully_and_full_undo_restores_the_docum
         applied_all += applied;
         while d.undo() {}
         assert_eq!(d.scene, original, "seed {seed}");
-        assert!(!d.is_dirty(), "seed {seed}: back at the opened state, nothing is unsaved");
+        assert!(
+            !d.is_dirty(),
+            "seed {seed}: back at the opened state, nothing is unsaved"
+        );
     }
     // Both ways must be exercised, or the property says little.
-    assert!(applied_all > seeds() * 15, "only {applied_all} edits applied; the generator is too timid");
-    assert!(refused_all * 20 > applied_all, "{refused_all} refused of {applied_all} applied");
+    assert!(
+        applied_all > seeds() * 15,
+        "only {applied_all} edits applied; the generator is too timid"
+    );
+    assert!(
+        refused_all * 20 > applied_all,
+        "{refused_all} refused of {applied_all} applied"
+    );
 }
 
 fn check_csg_operands(d: &Document, seed: u64) {
@@ -288,7 +357,13 @@ fn check_csg_operands(d: &Document, seed: u64) {
     for id in g.preorder() {
         let n = g.node(id);
         if let NodeKind::Csg(op) = n.kind {
-            assert_eq!(n.children.len(), 2, "seed {seed}: {} with {} operands", op.name(), n.children.len());
+            assert_eq!(
+                n.children.len(),
+                2,
+                "seed {seed}: {} with {} operands",
+                op.name(),
+                n.children.len()
+            );
             for &c in &n.children {
                 let k = &g.node(c).kind;
                 assert!(
@@ -303,8 +378,17 @@ fn check_csg_operands(d: &Document, seed: u64) {
 
 fn add_subtraction(d: &mut Document) -> NodeId {
     let root = d.scene.graph.root();
-    d.apply(Edit::AddNode { parent: root, kind: NodeKind::Csg(CsgOp::Subtraction) }).expect("adds");
-    *d.scene.graph.node(root).children.last().expect("the new node")
+    d.apply(Edit::AddNode {
+        parent: root,
+        kind: NodeKind::Csg(CsgOp::Subtraction),
+    })
+    .expect("adds");
+    *d.scene
+        .graph
+        .node(root)
+        .children
+        .last()
+        .expect("the new node")
 }
 
 #[test]
@@ -313,13 +397,23 @@ fn a_new_csg_node_holds_two_solids_and_renders() {
     let csg = add_subtraction(&mut d);
     let kids = d.scene.graph.node(csg).children.clone();
     assert_eq!(kids.len(), 2);
-    assert!(matches!(d.scene.graph.node(kids[0]).kind, NodeKind::Box { .. }));
-    assert!(matches!(d.scene.graph.node(kids[1]).kind, NodeKind::Sphere { .. }));
+    assert!(matches!(
+        d.scene.graph.node(kids[0]).kind,
+        NodeKind::Box { .. }
+    ));
+    assert!(matches!(
+        d.scene.graph.node(kids[1]).kind,
+        NodeKind::Sphere { .. }
+    ));
     let text = tracelab_core::write_scene(&d.scene);
     assert!(text.contains("Subtraction {"), "{text}");
     // Switching the operation and swapping operands are single edits that undo.
     let before = d.scene.clone();
-    d.apply(Edit::SetNodeKind { node: csg, kind: NodeKind::Csg(CsgOp::Union) }).expect("op change");
+    d.apply(Edit::SetNodeKind {
+        node: csg,
+        kind: NodeKind::Csg(CsgOp::Union),
+    })
+    .expect("op change");
     d.apply(Edit::SwapOperands { node: csg }).expect("swap");
     assert_eq!(d.scene.graph.node(csg).kind, NodeKind::Csg(CsgOp::Union));
     assert_eq!(d.scene.graph.node(csg).children, [kids[1], kids[0]]);
@@ -331,11 +425,17 @@ fn a_new_csg_node_holds_two_solids_and_renders() {
 fn deleting_one_operand_leaves_the_other_in_the_csg_node_s_place() {
     let mut d = Document::builtin();
     let csg = add_subtraction(&mut d);
-    let [a, b] = d.scene.graph.node(csg).children[..] else { panic!("two operands") };
+    let [a, b] = d.scene.graph.node(csg).children[..] else {
+        panic!("two operands")
+    };
     d.apply(Edit::DeleteNode { node: b }).expect("deletes");
     let root = d.scene.graph.root();
     let kids = &d.scene.graph.node(root).children;
-    assert_eq!(kids.last(), Some(&a), "the Box takes the Subtraction's place");
+    assert_eq!(
+        kids.last(),
+        Some(&a),
+        "the Box takes the Subtraction's place"
+    );
     assert!(!kids.contains(&csg));
 }
 
@@ -350,7 +450,11 @@ fn deleting_a_csg_operand_under_a_transform_keeps_colours_and_saves_faithfully()
     let choices = [None, Some(1), Some(3)];
     let mut cases = 0;
     for nested in [false, true] {
-        for (a_mat, b_mat, t_mat) in choices.iter().flat_map(|&a| choices.iter().flat_map(move |&b| choices.map(move |t| (a, b, t)))) {
+        for (a_mat, b_mat, t_mat) in choices.iter().flat_map(|&a| {
+            choices
+                .iter()
+                .flat_map(move |&b| choices.map(move |t| (a, b, t)))
+        }) {
             for delete_a in [false, true] {
                 let t = format!(
                     "{}Transform {{ Translate 0 1 0 Subtraction {{ {}Box {{ min -1 -1 -1 max 1 1 1 }} {}Sphere {{ center 0 0 0 radius 1.3 }} }} }}",
@@ -359,30 +463,51 @@ fn deleting_a_csg_operand_under_a_transform_keeps_colours_and_saves_faithfully()
                     index(b_mat)
                 );
                 // Nested: the Transform is operand B of a Union.
-                let t = if nested { format!("Union {{ Sphere {{ center 3 0 0 radius 1 }} {t} }}") } else { t };
+                let t = if nested {
+                    format!("Union {{ Sphere {{ center 3 0 0 radius 1 }} {t} }}")
+                } else {
+                    t
+                };
                 let text = format!(
                     "PerspectiveCamera {{ center 0 0 10 direction 0 0 -1 up 0 1 0 angle 40 }}\n\
                      Lights {{ numLights 1 DirectionalLight {{ direction -1 -1 -1 color 1 1 1 }} }}\n\
                      Materials {{ numMaterials 4 Material {{ diffuseColor 1 0 0 }} Material {{ diffuseColor 0 1 0 }} Material {{ diffuseColor 0 0 1 }} Material {{ diffuseColor 1 1 0 }} }}\n\
                      Group {{ numObjects 3 MaterialIndex 2 Sphere {{ center -3 0 0 radius 1 }} {t} Sphere {{ center 0 -3 0 radius 1 }} }}\n"
                 );
-                let scene = parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0;
+                let scene = parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new())
+                    .into_result()
+                    .expect("parses")
+                    .0;
                 let mut d = Document::new(scene, None);
                 let g = &d.scene.graph;
-                let sub = g.iter().find(|(_, n)| n.kind == NodeKind::Csg(CsgOp::Subtraction)).map(|(id, _)| id).expect("the Subtraction");
+                let sub = g
+                    .iter()
+                    .find(|(_, n)| n.kind == NodeKind::Csg(CsgOp::Subtraction))
+                    .map(|(id, _)| id)
+                    .expect("the Subtraction");
                 let transform = g.parents()[sub.index()].expect("its Transform");
-                let [a, b] = g.node(sub).children[..] else { panic!("two operands") };
+                let [a, b] = g.node(sub).children[..] else {
+                    panic!("two operands")
+                };
                 let (gone, kept) = if delete_a { (a, b) } else { (b, a) };
                 let before = g.effective_materials();
-                d.apply(Edit::DeleteNode { node: gone }).unwrap_or_else(|e| panic!("case {cases}: refused: {e}\n{text}"));
+                d.apply(Edit::DeleteNode { node: gone })
+                    .unwrap_or_else(|e| panic!("case {cases}: refused: {e}\n{text}"));
                 let after = d.scene.graph.effective_materials();
                 for (id, _) in d.scene.graph.iter() {
                     // The Transform may now carry the survivor's material for it.
                     if id != transform {
-                        assert_eq!(after[id.index()], before[id.index()], "case {cases}: node {id:?} changed colour\n{text}");
+                        assert_eq!(
+                            after[id.index()],
+                            before[id.index()],
+                            "case {cases}: node {id:?} changed colour\n{text}"
+                        );
                     }
                 }
-                assert!(d.scene.graph.path_to(kept).is_some(), "case {cases}: the survivor is in the scene");
+                assert!(
+                    d.scene.graph.path_to(kept).is_some(),
+                    "case {cases}: the survivor is in the scene"
+                );
                 check_save(&mut d, cases, 0);
                 cases += 1;
             }
@@ -398,11 +523,14 @@ fn a_csg_operand_cannot_become_a_group_or_a_triangle() {
     let a = d.scene.graph.node(csg).children[0];
     let before = d.scene.clone();
     assert!(d.apply(Edit::WrapInGroup { node: a }).is_err());
-    let tri = NodeKind::Triangle { vertices: [Vec3::ZERO, Vec3::X, Vec3::Y] };
+    let tri = NodeKind::Triangle {
+        vertices: [Vec3::ZERO, Vec3::X, Vec3::Y],
+    };
     assert!(d.apply(Edit::SetNodeKind { node: a, kind: tri }).is_err());
     assert_eq!(d.scene, before);
     // Wrapping in a Transform keeps it a solid, so that is allowed.
-    d.apply(Edit::WrapInTransform { node: a }).expect("a Transform of a solid is a solid");
+    d.apply(Edit::WrapInTransform { node: a })
+        .expect("a Transform of a solid is a solid");
 }
 
 #[test]

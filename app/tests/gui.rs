@@ -7,10 +7,9 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
 use glam::Vec3;
-use tracelab::gui::{AppOptions, Pending, TracelabApp};
 use tracelab::document::Selection;
+use tracelab::gui::{AppOptions, Pending, TracelabApp};
 use tracelab_core::{MeshCache, NodeId, NodeKind, TransformOp, View};
-
 
 mod common;
 use common::settle;
@@ -24,7 +23,11 @@ fn repo(rel: &str) -> PathBuf {
 /// ../shared fails them here.
 fn shared_scene(name: &str) -> PathBuf {
     let p = repo("../shared/mit6837/scenes").join(name);
-    assert!(p.is_file(), "{} is missing: this test needs ../shared beside the checkout", p.display());
+    assert!(
+        p.is_file(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        p.display()
+    );
     p
 }
 
@@ -77,7 +80,8 @@ fn edit_save_undo(scene: PathBuf) {
     let original = h.state().doc.scene.clone();
     let (id, t) = translate_transform(h.state());
 
-    let label = tracelab::gui::panels::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    let label =
+        tracelab::gui::panels::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
     h.get_all_by_label_contains(&label)
         .next()
         .expect("tree row")
@@ -225,11 +229,12 @@ fn closing_with_unsaved_changes_asks_first() {
     let mut h = harness(None, (32, 32));
     settle(&mut h);
     let (id, t) = translate_transform(h.state());
-    h.state_mut().apply(tracelab::document::edit::Edit::SetTransformOp {
-        node: id,
-        index: 0,
-        op: TransformOp::Translate(t + Vec3::X),
-    });
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::SetTransformOp {
+            node: id,
+            index: 0,
+            op: TransformOp::Translate(t + Vec3::X),
+        });
     h.step();
     h.input_mut()
         .viewports
@@ -379,7 +384,9 @@ fn a_scene_dropped_on_the_window_opens() {
     h.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped(path.clone())));
-    step_until(&mut h, 10, "the dropped scene", |a| a.doc.path.as_deref() == Some(path.as_path()));
+    step_until(&mut h, 10, "the dropped scene", |a| {
+        a.doc.path.as_deref() == Some(path.as_path())
+    });
     assert_eq!(h.state().recent.first(), Some(&path));
 }
 
@@ -387,9 +394,10 @@ fn a_scene_dropped_on_the_window_opens() {
 fn opening_over_unsaved_changes_asks_and_discard_opens() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(
-        tracelab_core::Material::diffuse(Vec3::ONE),
-    ));
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::AddMaterial(
+            tracelab_core::Material::diffuse(Vec3::ONE),
+        ));
     let target = repo("scenes/hierarchy.txt");
     h.state_mut().open(&target);
     // The file is read first; the question comes once there is something to switch to.
@@ -449,7 +457,9 @@ fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
         .type_text(&target.display().to_string());
     h.step();
     h.get_by_label("Open").click();
-    step_until(&mut h, 10, "the file to open", |a| a.doc.path.as_deref() == Some(target.as_path()));
+    step_until(&mut h, 10, "the file to open", |a| {
+        a.doc.path.as_deref() == Some(target.as_path())
+    });
     assert!(h.state().dialog.is_none());
 }
 
@@ -507,8 +517,14 @@ fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
     let generation = h.state().doc.generation;
     h.get_by_label("Union").click();
     h.step();
-    assert_eq!(h.state().doc.scene.graph.node(csg).kind, NodeKind::Csg(tracelab_core::CsgOp::Union));
-    assert!(h.state().doc.generation > generation, "the edit restarts the render");
+    assert_eq!(
+        h.state().doc.scene.graph.node(csg).kind,
+        NodeKind::Csg(tracelab_core::CsgOp::Union)
+    );
+    assert!(
+        h.state().doc.generation > generation,
+        "the edit restarts the render"
+    );
     h.get_by_label("Swap A and B").click();
     h.step();
     let after = h.state().doc.scene.graph.node(csg).children.clone();
@@ -523,7 +539,10 @@ fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
     });
     let node = pixel.expect("the centre pixel shows the union");
     assert!(
-        matches!(h.state().doc.scene.graph.node(node).kind, NodeKind::Sphere { .. }),
+        matches!(
+            h.state().doc.scene.graph.node(node).kind,
+            NodeKind::Sphere { .. }
+        ),
         "an operand, not the CSG node"
     );
 }
@@ -577,20 +596,32 @@ fn shade_back_changes_the_picture_of_an_inside_view() {
     h.step();
     settle(&mut h);
     assert!(h.state().view.shade_back);
-    assert_ne!(before, on_screen(&h), "shade back changed nothing on screen");
+    assert_ne!(
+        before,
+        on_screen(&h),
+        "shade back changed nothing on screen"
+    );
 }
 
 // ---- Issue 10 and 16: each test below failed on e638896 (see the commit message). ----
 
 /// Steps until `done` holds, failing after `secs`; for work that finishes in the background.
-fn step_until(h: &mut Harness<'static, TracelabApp>, secs: u64, what: &str, done: impl Fn(&TracelabApp) -> bool) {
+fn step_until(
+    h: &mut Harness<'static, TracelabApp>,
+    secs: u64,
+    what: &str,
+    done: impl Fn(&TracelabApp) -> bool,
+) {
     let start = Instant::now();
     loop {
         h.step();
         if done(h.state()) {
             return;
         }
-        assert!(start.elapsed() < Duration::from_secs(secs), "timed out waiting for {what}");
+        assert!(
+            start.elapsed() < Duration::from_secs(secs),
+            "timed out waiting for {what}"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
 }
@@ -612,22 +643,30 @@ fn the_pixel_inspector_retraces_its_pixel_after_an_edit_and_keeps_the_selection(
     let before = inspected_hit(h.state()).expect("the centre pixel hits the sphere");
     let (id, _) = translate_transform(h.state());
     h.state_mut().doc.selection = Some(Selection::Node(id));
-    h.state_mut().apply(tracelab::document::edit::Edit::SetTransformOp {
-        node: id,
-        index: 0,
-        op: TransformOp::Translate(Vec3::new(0.3, 0.2, 0.5)),
-    });
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::SetTransformOp {
+            node: id,
+            index: 0,
+            op: TransformOp::Translate(Vec3::new(0.3, 0.2, 0.5)),
+        });
     settle(&mut h);
     h.step();
     let after = inspected_hit(h.state()).expect("still a hit");
-    assert_ne!(before.world_point, after.world_point, "the inspector kept the old story");
+    assert_ne!(
+        before.world_point, after.world_point,
+        "the inspector kept the old story"
+    );
     // Exactly what the new render's scene gives for that pixel.
     let fresh = h.state().worker.with_published(|p| {
         let p = p.expect("rendered");
         tracelab_core::render::inspect_pixel(&p.job.scene, &p.compiled, &p.job.settings, 20, 20)
     });
     assert_eq!(Some(&fresh), h.state().story.as_ref().map(|(s, _)| s));
-    assert_eq!(h.state().doc.selection, Some(Selection::Node(id)), "re-tracing must not change the selection");
+    assert_eq!(
+        h.state().doc.selection,
+        Some(Selection::Node(id)),
+        "re-tracing must not change the selection"
+    );
 }
 
 #[test]
@@ -635,7 +674,10 @@ fn the_pixel_inspector_forgets_a_deleted_box() {
     let path = temp_dir("inspect-delete").join("box.txt");
     std::fs::write(
         &path,
-        SPHERE_SCENE.replace("Transform { OP Sphere { center 0 0 0 radius 1 } }", "Box { min -1 -1 -1 max 1 1 1 }"),
+        SPHERE_SCENE.replace(
+            "Transform { OP Sphere { center 0 0 0 radius 1 } }",
+            "Box { min -1 -1 -1 max 1 1 1 }",
+        ),
     )
     .expect("write");
     let mut h = harness(Some(path), (40, 40));
@@ -646,20 +688,31 @@ fn the_pixel_inspector_forgets_a_deleted_box() {
     }
     let hit = inspected_hit(h.state()).expect("the centre pixel shows the box");
     let _ = h.get_by_label_contains("Hit Box");
-    h.state_mut().apply(tracelab::document::edit::Edit::DeleteNode { node: hit.node });
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::DeleteNode { node: hit.node });
     settle(&mut h);
     for _ in 0..3 {
         h.step();
     }
-    assert!(inspected_hit(h.state()).is_none(), "the ray now misses: {:?}", inspected_hit(h.state()));
-    assert!(h.query_by_label_contains("Hit Box").is_none(), "the inspector still shows the deleted box");
+    assert!(
+        inspected_hit(h.state()).is_none(),
+        "the ray now misses: {:?}",
+        inspected_hit(h.state())
+    );
+    assert!(
+        h.query_by_label_contains("Hit Box").is_none(),
+        "the inspector still shows the deleted box"
+    );
 }
 
 /// Two scenes of the same shape whose only TriangleMesh names `obj`, so its node id is the same.
 fn mesh_scene(tag: &str, obj: &str) -> PathBuf {
     let path = temp_dir(tag).join(format!("{tag}.txt"));
     let text = SPHERE_SCENE
-        .replace("Sphere { center 0 0 0 radius 1 }", &format!("TriangleMesh {{ obj_file {obj} }}"))
+        .replace(
+            "Sphere { center 0 0 0 radius 1 }",
+            &format!("TriangleMesh {{ obj_file {obj} }}"),
+        )
         .replace("OP", "UniformScale 1");
     std::fs::write(&path, text).expect("write");
     path
@@ -676,7 +729,9 @@ fn mesh_node(app: &TracelabApp) -> NodeId {
 }
 
 fn obj_field(h: &Harness<'static, TracelabApp>) -> String {
-    h.get_by_role(egui::accesskit::Role::TextInput).value().unwrap_or_default()
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .value()
+        .unwrap_or_default()
 }
 
 #[test]
@@ -693,12 +748,18 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     h.step();
     assert_eq!(obj_field(&h), cube);
     h.state_mut().open(&b);
-    step_until(&mut h, 30, "the second scene", |a| a.doc.path.as_deref() == Some(b.as_path()));
+    step_until(&mut h, 30, "the second scene", |a| {
+        a.doc.path.as_deref() == Some(b.as_path())
+    });
     assert_eq!(mesh_node(h.state()), id, "same shape, same node id");
     h.state_mut().doc.selection = Some(Selection::Node(id));
     h.step();
     h.step();
-    assert_eq!(obj_field(&h), torus, "the field shows the previous document's file");
+    assert_eq!(
+        obj_field(&h),
+        torus,
+        "the field shows the previous document's file"
+    );
     h.get_by_label("Load / reload").click();
     h.step();
     h.step();
@@ -706,13 +767,18 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
         NodeKind::TriangleMesh { obj_file, .. } => obj_file.clone(),
         _ => String::new(),
     };
-    assert_eq!(file(h.state()), torus, "Load swapped in the other scene's mesh");
+    assert_eq!(
+        file(h.state()),
+        torus,
+        "Load swapped in the other scene's mesh"
+    );
     // An edit from elsewhere, then undo and redo: the field follows each time.
     let mut kind = h.state().doc.scene.graph.node(id).kind.clone();
     if let NodeKind::TriangleMesh { obj_file, .. } = &mut kind {
         *obj_file = cube.clone();
     }
-    h.state_mut().apply(tracelab::document::edit::Edit::SetNodeKind { node: id, kind });
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::SetNodeKind { node: id, kind });
     h.step();
     h.step();
     assert_eq!(obj_field(&h), cube);
@@ -721,7 +787,10 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     h.step();
     assert_eq!(file(h.state()), torus);
     assert_eq!(obj_field(&h), torus, "after undo");
-    h.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
     h.step();
     h.step();
     assert_eq!(obj_field(&h), cube, "after redo");
@@ -730,10 +799,17 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
 /// A scene using the 871k-triangle dragon of ../shared, written to a temporary folder.
 fn dragon_scene() -> PathBuf {
     let dragon = repo("../shared/meshes/dragon_vrip.obj");
-    assert!(dragon.is_file(), "{} is missing: this test needs ../shared beside the checkout", dragon.display());
+    assert!(
+        dragon.is_file(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        dragon.display()
+    );
     let path = temp_dir("dragon").join("dragon.txt");
     let text = SPHERE_SCENE
-        .replace("Sphere { center 0 0 0 radius 1 }", &format!("TriangleMesh {{ obj_file {} }}", dragon.display()))
+        .replace(
+            "Sphere { center 0 0 0 radius 1 }",
+            &format!("TriangleMesh {{ obj_file {} }}", dragon.display()),
+        )
         .replace("OP", "UniformScale 8");
     std::fs::write(&path, text).expect("write");
     path
@@ -748,8 +824,16 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
     let before = h.state().doc.scene.clone();
     let t = Instant::now();
     h.state_mut().open(&dragon);
-    assert!(t.elapsed() < Duration::from_millis(300), "open() blocked for {:?}", t.elapsed());
-    assert_eq!(h.state().doc.path, None, "the old scene stays open while the new one loads");
+    assert!(
+        t.elapsed() < Duration::from_millis(300),
+        "open() blocked for {:?}",
+        t.elapsed()
+    );
+    assert_eq!(
+        h.state().doc.path,
+        None,
+        "the old scene stays open while the new one loads"
+    );
     h.step();
     let _ = h.get_by_label_contains("Opening dragon.txt");
     h.get_by_label("Cancel").click();
@@ -761,7 +845,10 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
         std::thread::sleep(Duration::from_millis(20));
     }
     // Not assert_eq: the Debug of an 871k-triangle scene is hundreds of MB.
-    assert!(h.state().doc.scene == before, "a cancelled load replaced the scene");
+    assert!(
+        h.state().doc.scene == before,
+        "a cancelled load replaced the scene"
+    );
     assert!(h.query_by_label_contains("Opening dragon.txt").is_none());
     // Opened for real: frames keep coming while it loads.
     h.state_mut().open(&dragon);
@@ -774,7 +861,10 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
         assert!(start.elapsed() < Duration::from_secs(60), "never loaded");
         std::thread::sleep(Duration::from_millis(5));
     }
-    assert!(slowest < Duration::from_millis(300), "a frame took {slowest:?} while loading");
+    assert!(
+        slowest < Duration::from_millis(300),
+        "a frame took {slowest:?} while loading"
+    );
     assert_eq!(h.state().doc.scene.graph.stats().triangles, 871_414);
 }
 
@@ -784,8 +874,19 @@ fn a_large_scene_given_at_start_does_not_hold_up_the_first_frame() {
     let dragon = dragon_scene();
     // What eframe does with `tracelab dragon.txt`: make the app, then paint frames.
     let t = Instant::now();
-    let mut app = TracelabApp::new(None, AppOptions { scene: Some(dragon.clone()), fixed_size: Some((32, 32)), ..AppOptions::default() });
-    assert!(t.elapsed() < Duration::from_millis(300), "making the app took {:?}", t.elapsed());
+    let mut app = TracelabApp::new(
+        None,
+        AppOptions {
+            scene: Some(dragon.clone()),
+            fixed_size: Some((32, 32)),
+            ..AppOptions::default()
+        },
+    );
+    assert!(
+        t.elapsed() < Duration::from_millis(300),
+        "making the app took {:?}",
+        t.elapsed()
+    );
     let ctx = egui::Context::default();
     let mut frames_before = 0;
     let mut slowest = Duration::ZERO;
@@ -799,21 +900,40 @@ fn a_large_scene_given_at_start_does_not_hold_up_the_first_frame() {
         assert!(t.elapsed() < Duration::from_secs(60), "never loaded");
         std::thread::sleep(Duration::from_millis(10));
     }
-    assert!(frames_before > 5, "only {frames_before} frames before the scene was there");
-    assert!(slowest < Duration::from_millis(300), "a frame took {slowest:?}");
+    assert!(
+        frames_before > 5,
+        "only {frames_before} frames before the scene was there"
+    );
+    assert!(
+        slowest < Duration::from_millis(300),
+        "a frame took {slowest:?}"
+    );
 }
 
 #[test]
 fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::AddMaterial(
+            tracelab_core::Material::diffuse(Vec3::ONE),
+        ));
     let edited = h.state().doc.scene.clone();
     let bad = temp_dir("bad-dirty").join("broken.txt");
-    std::fs::write(&bad, "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 oops\n}\n").expect("write");
+    std::fs::write(
+        &bad,
+        "OrthographicCamera {\n    center 0 0 10\n    direction 0 0 oops\n}\n",
+    )
+    .expect("write");
     h.state_mut().open(&bad);
-    step_until(&mut h, 10, "an answer", |a| a.confirm.is_some() || a.doc.messages.iter().any(|m| m.contains("broken.txt:3:")));
-    assert_eq!(h.state().confirm, None, "asked about unsaved changes with nothing to switch to");
+    step_until(&mut h, 10, "an answer", |a| {
+        a.confirm.is_some() || a.doc.messages.iter().any(|m| m.contains("broken.txt:3:"))
+    });
+    assert_eq!(
+        h.state().confirm,
+        None,
+        "asked about unsaved changes with nothing to switch to"
+    );
     assert_eq!(h.state().doc.scene, edited);
     assert!(h.state().doc.is_dirty());
 }
@@ -821,7 +941,8 @@ fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() 
 fn focus_text_and_type(h: &mut Harness<'static, TracelabApp>, text: &str) {
     h.get_by_role(egui::accesskit::Role::TextInput).focus();
     h.step();
-    h.get_by_role(egui::accesskit::Role::TextInput).type_text(text);
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text(text);
     h.step();
 }
 
@@ -836,7 +957,9 @@ fn enter_in_the_open_dialog_opens_the_typed_name() {
     let target = repo("scenes/flat_transforms.txt");
     focus_text_and_type(&mut h, &target.display().to_string());
     h.key_press(egui::Key::Enter);
-    step_until(&mut h, 10, "the file to open", |a| a.doc.path.as_deref() == Some(target.as_path()));
+    step_until(&mut h, 10, "the file to open", |a| {
+        a.doc.path.as_deref() == Some(target.as_path())
+    });
     assert!(h.state().dialog.is_none());
 }
 
@@ -844,7 +967,10 @@ fn enter_in_the_open_dialog_opens_the_typed_name() {
 fn enter_in_the_save_as_dialog_saves() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::S);
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
     for _ in 0..3 {
         h.step();
     }
@@ -876,7 +1002,10 @@ fn the_file_dialog_lists_scene_files_and_folders_only() {
     }
     let _ = h.get_by_label("a.txt");
     let _ = h.get_by_label("sub/");
-    assert!(h.query_by_label("b.obj").is_none(), "the Open dialog lists a mesh file");
+    assert!(
+        h.query_by_label("b.obj").is_none(),
+        "the Open dialog lists a mesh file"
+    );
 }
 
 #[test]
@@ -899,7 +1028,10 @@ fn the_file_dialog_never_shows_the_folder_as_a_dot() {
 fn file_new_asks_about_unsaved_changes_then_starts_an_untitled_scene() {
     let mut h = harness(Some(repo("scenes/hierarchy.txt")), (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::AddMaterial(
+            tracelab_core::Material::diffuse(Vec3::ONE),
+        ));
     h.get_by_label("File").click();
     h.step();
     h.step();
@@ -907,21 +1039,30 @@ fn file_new_asks_about_unsaved_changes_then_starts_an_untitled_scene() {
     for _ in 0..2 {
         h.step();
     }
-    assert!(h.state().confirm.is_some(), "New over unsaved changes must ask");
+    assert!(
+        h.state().confirm.is_some(),
+        "New over unsaved changes must ask"
+    );
     h.get_by_label("Discard changes").click();
     for _ in 0..2 {
         h.step();
     }
     assert_eq!(h.state().doc.path, None);
     assert!(!h.state().doc.is_dirty());
-    assert_eq!(h.state().doc.scene, tracelab::document::Document::builtin().scene);
+    assert_eq!(
+        h.state().doc.scene,
+        tracelab::document::Document::builtin().scene
+    );
 }
 
 #[test]
 fn ctrl_q_quits_asking_first_about_unsaved_changes() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::AddMaterial(
+            tracelab_core::Material::diffuse(Vec3::ONE),
+        ));
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
     for _ in 0..3 {
         h.step();
@@ -942,18 +1083,29 @@ fn a_new_sphere_inherits_the_groups_material_and_says_which() {
     for _ in 0..3 {
         h.step();
     }
-    let Some(Selection::Node(id)) = h.state().doc.selection else { panic!("the new sphere is selected") };
+    let Some(Selection::Node(id)) = h.state().doc.selection else {
+        panic!("the new sphere is selected")
+    };
     let shown = h.get_by_label("material").value().unwrap_or_default();
-    assert!(shown.contains("Material 0") && !shown.contains("default"), "the inspector says {shown:?}");
+    assert!(
+        shown.contains("Material 0") && !shown.contains("default"),
+        "the inspector says {shown:?}"
+    );
     // What it shows is what it renders with, and what the saved file gives back.
     let eff = h.state().doc.scene.graph.effective_materials()[id.index()];
     assert_eq!(eff, Some(0));
     let out = temp_dir("inherit").join("saved.txt");
     h.state_mut().save_as(&out);
-    let (back, _) = tracelab_core::load_scene(&out, &mut MeshCache::new()).into_result().expect("reads back");
+    let (back, _) = tracelab_core::load_scene(&out, &mut MeshCache::new())
+        .into_result()
+        .expect("reads back");
     let spheres: Vec<Option<u32>> = {
         let eff = back.graph.effective_materials();
-        back.graph.iter().filter(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. })).map(|(i, _)| eff[i.index()]).collect()
+        back.graph
+            .iter()
+            .filter(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. }))
+            .map(|(i, _)| eff[i.index()])
+            .collect()
     };
     assert_eq!(spheres, [Some(0), Some(0)]);
 }
@@ -968,21 +1120,38 @@ fn the_pixel_inspector_covers_neither_the_tree_nor_the_image() {
     }
     let image = h.state().shown()[0].rect;
     let mut inspector = Vec::new();
-    for label in ["Pixel (32, 30)", "World ray:", "hit point (world)", "colour (sum)"] {
+    for label in [
+        "Pixel (32, 30)",
+        "World ray:",
+        "hit point (world)",
+        "colour (sum)",
+    ] {
         if let Some(n) = h.query_by_label_contains(label) {
             inspector.push(n.rect());
         }
     }
     assert!(inspector.len() >= 2, "the pixel inspector shows its story");
     let mut tree = Vec::new();
-    for label in ["Camera (perspective)", "Camera (orthographic)", "Background", "Lights (", "Materials ("] {
+    for label in [
+        "Camera (perspective)",
+        "Camera (orthographic)",
+        "Background",
+        "Lights (",
+        "Materials (",
+    ] {
         tree.extend(h.query_all_by_label_contains(label).map(|n| n.rect()));
     }
     assert!(!tree.is_empty());
     for r in &inspector {
-        assert!(!r.intersects(image), "pixel inspector {r:?} covers the image {image:?}");
+        assert!(
+            !r.intersects(image),
+            "pixel inspector {r:?} covers the image {image:?}"
+        );
         for t in &tree {
-            assert!(!r.intersects(*t), "pixel inspector {r:?} covers the tree row {t:?}");
+            assert!(
+                !r.intersects(*t),
+                "pixel inspector {r:?} covers the tree row {t:?}"
+            );
         }
     }
 }
@@ -993,14 +1162,33 @@ fn drag_by(h: &mut Harness<'static, TracelabApp>, label: &str, dx: f32) {
     let push = |h: &mut Harness<'static, TracelabApp>, e: egui::Event| h.input_mut().events.push(e);
     push(h, egui::Event::PointerMoved(at));
     h.step();
-    push(h, egui::Event::PointerButton { pos: at, button: egui::PointerButton::Primary, pressed: true, modifiers: egui::Modifiers::NONE });
+    push(
+        h,
+        egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed: true,
+            modifiers: egui::Modifiers::NONE,
+        },
+    );
     h.step();
     for i in 1..=6 {
-        push(h, egui::Event::PointerMoved(at + egui::vec2(dx * i as f32 / 6.0, 0.0)));
+        push(
+            h,
+            egui::Event::PointerMoved(at + egui::vec2(dx * i as f32 / 6.0, 0.0)),
+        );
         h.step();
     }
     let end = at + egui::vec2(dx, 0.0);
-    push(h, egui::Event::PointerButton { pos: end, button: egui::PointerButton::Primary, pressed: false, modifiers: egui::Modifiers::NONE });
+    push(
+        h,
+        egui::Event::PointerButton {
+            pos: end,
+            button: egui::PointerButton::Primary,
+            pressed: false,
+            modifiers: egui::Modifiers::NONE,
+        },
+    );
     h.step();
 }
 
@@ -1009,7 +1197,10 @@ fn dragging_a_translate_moves_by_a_step_scaled_to_the_scene_and_the_transform() 
     // The camera sees about 5.4 units across; the Translate is scaled by 5 (listed after it).
     let path = temp_dir("drag-speed").join("scaled.txt");
     let text = SPHERE_SCENE
-        .replace("OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }", "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }")
+        .replace(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
+            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
+        )
         .replace("OP", "UniformScale 5 Translate 0 0 0")
         .replace("radius 1", "radius 0.1");
     std::fs::write(&path, text).expect("write");
@@ -1028,11 +1219,18 @@ fn dragging_a_translate_moves_by_a_step_scaled_to_the_scene_and_the_transform() 
     h.step();
     h.step();
     drag_by(&mut h, "Translate x", 60.0);
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(id).kind else { panic!() };
-    let Some(TransformOp::Translate(t)) = ops.get(1) else { panic!("{ops:?}") };
+    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(id).kind else {
+        panic!()
+    };
+    let Some(TransformOp::Translate(t)) = ops.get(1) else {
+        panic!("{ops:?}")
+    };
     let world = 5.0 * t.x;
     assert!(world > 0.05, "the drag moved nothing: {world}");
-    assert!(world < 5.4 * 0.25, "60 px moved the object {world} world units in a view 5.4 across");
+    assert!(
+        world < 5.4 * 0.25,
+        "60 px moved the object {world} world units in a view 5.4 across"
+    );
 }
 
 // ---- Issue 16: layout and small things ----
@@ -1046,7 +1244,10 @@ fn a_side_panel_dragged_wide_leaves_the_render_view_usable() {
     for _ in 0..3 {
         h.step();
     }
-    let splitters: Vec<_> = h.query_all_by_role(egui::accesskit::Role::Splitter).map(|n| n.rect().center().x).collect();
+    let splitters: Vec<_> = h
+        .query_all_by_role(egui::accesskit::Role::Splitter)
+        .map(|n| n.rect().center().x)
+        .collect();
     assert!(!splitters.is_empty(), "no panel resize handles found");
     // The leftmost handle is the tree panel's; ask for it at 1000 px.
     let left = h
@@ -1055,7 +1256,10 @@ fn a_side_panel_dragged_wide_leaves_the_render_view_usable() {
         .expect("handle");
     left.set_value_accesskit(1000.0 / 1200.0);
     settle(&mut h);
-    let width = h.state().worker.with_published(|p| p.expect("rendered").job.settings.width);
+    let width = h
+        .state()
+        .worker
+        .with_published(|p| p.expect("rendered").job.settings.width);
     assert!(width >= 300, "the render view is {width} px wide");
 }
 
@@ -1076,13 +1280,20 @@ fn the_fixed_render_size_refuses_nan_and_sizes_past_the_limit() {
         h.step();
     };
     type_into(&mut h, "w", "nan");
-    assert_eq!(h.state().view.fixed_size, Some((40, 40)), "nan was taken as a size");
+    assert_eq!(
+        h.state().view.fixed_size,
+        Some((40, 40)),
+        "nan was taken as a size"
+    );
     type_into(&mut h, "w", "8192");
     assert_eq!(h.state().view.fixed_size, Some((8192, 40)));
     // 8192 × 16384 is more pixels than core renders (8192 × 8192).
     type_into(&mut h, "h", "16384");
     let (w, hh) = h.state().view.fixed_size.expect("fixed");
-    assert!(tracelab_core::render::check_image_size(w, hh).is_ok(), "{w}×{hh} accepted");
+    assert!(
+        tracelab_core::render::check_image_size(w, hh).is_ok(),
+        "{w}×{hh} accepted"
+    );
 }
 
 #[test]
@@ -1115,8 +1326,16 @@ fn twenty_thousand_nested_groups_make_a_short_breadcrumb() {
     h.step();
     h.step();
     let node = h.get_by_label_contains("Group › Group");
-    let crumb = node.accesskit_node().label().or_else(|| node.value()).unwrap_or_default();
-    assert!(crumb.chars().count() < 200, "breadcrumb of {} characters", crumb.chars().count());
+    let crumb = node
+        .accesskit_node()
+        .label()
+        .or_else(|| node.value())
+        .unwrap_or_default();
+    assert!(
+        crumb.chars().count() < 200,
+        "breadcrumb of {} characters",
+        crumb.chars().count()
+    );
     assert!(crumb.contains('…') && crumb.ends_with("Sphere"), "{crumb}");
 }
 
@@ -1124,18 +1343,31 @@ fn twenty_thousand_nested_groups_make_a_short_breadcrumb() {
 fn save_says_which_comments_it_would_drop_before_writing() {
     let d = temp_dir("lost-comments");
     let path = d.join("s.txt");
-    let text = SPHERE_SCENE.replace("size 2.5", "size # two and a half\n 2.5").replace("OP", "UniformScale 1");
+    let text = SPHERE_SCENE
+        .replace("size 2.5", "size # two and a half\n 2.5")
+        .replace("OP", "UniformScale 1");
     std::fs::write(&path, &text).expect("write");
     let mut h = harness(Some(path.clone()), (16, 16));
     settle(&mut h);
-    h.state_mut().apply(tracelab::document::edit::Edit::AddMaterial(tracelab_core::Material::diffuse(Vec3::ONE)));
+    h.state_mut()
+        .apply(tracelab::document::edit::Edit::AddMaterial(
+            tracelab_core::Material::diffuse(Vec3::ONE),
+        ));
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     for _ in 0..3 {
         h.step();
     }
-    assert_eq!(std::fs::read_to_string(&path).expect("read"), text, "saved without a word");
+    assert_eq!(
+        std::fs::read_to_string(&path).expect("read"),
+        text,
+        "saved without a word"
+    );
     let _ = h.get_by_label("Saving loses something");
-    assert!(h.query_all_by_label_contains("saving the scene drops it").count() >= 1);
+    assert!(
+        h.query_all_by_label_contains("saving the scene drops it")
+            .count()
+            >= 1
+    );
     h.get_by_label("Save anyway").click();
     for _ in 0..2 {
         h.step();
@@ -1157,7 +1389,6 @@ fn layout_harness(width: f32, memory: Option<egui::Memory>) -> Harness<'static, 
         })
 }
 
-
 /// The x of the tree panel's resize handle (the leftmost one).
 fn tree_edge(h: &Harness<'static, TracelabApp>) -> f32 {
     h.query_all_by_role(egui::accesskit::Role::Splitter)
@@ -1167,7 +1398,9 @@ fn tree_edge(h: &Harness<'static, TracelabApp>) -> f32 {
 }
 
 fn render_width(h: &Harness<'static, TracelabApp>) -> u32 {
-    h.state().worker.with_published(|p| p.expect("rendered").job.settings.width)
+    h.state()
+        .worker
+        .with_published(|p| p.expect("rendered").job.settings.width)
 }
 
 #[test]
@@ -1185,20 +1418,36 @@ fn a_remembered_1000_px_panel_is_clamped_and_reset_layout_restores_the_defaults(
     for _ in 0..3 {
         wide.step();
     }
-    assert!((tree_edge(&wide) - 1000.0).abs() < 10.0, "the tree is {} px wide", tree_edge(&wide));
+    assert!(
+        (tree_edge(&wide) - 1000.0).abs() < 10.0,
+        "the tree is {} px wide",
+        tree_edge(&wide)
+    );
     let memory = wide.ctx.memory(|m| m.clone());
     // ...and started on a 1200 px one.
     let mut h = layout_harness(1200.0, Some(memory));
     settle(&mut h);
-    assert!(render_width(&h) >= 300, "the render view is {} px wide", render_width(&h));
+    assert!(
+        render_width(&h) >= 300,
+        "the render view is {} px wide",
+        render_width(&h)
+    );
     assert!(tree_edge(&h) < 1200.0 - 320.0);
     h.get_by_label("View").click();
     h.step();
     h.step();
     h.get_by_label("Reset layout").click();
     settle(&mut h);
-    assert!((tree_edge(&h) - 280.0).abs() < 10.0, "after Reset layout the tree is {} px wide", tree_edge(&h));
-    assert!(render_width(&h) > 500, "the view has its default room: {}", render_width(&h));
+    assert!(
+        (tree_edge(&h) - 280.0).abs() < 10.0,
+        "after Reset layout the tree is {} px wide",
+        tree_edge(&h)
+    );
+    assert!(
+        render_width(&h) > 500,
+        "the view has its default room: {}",
+        render_width(&h)
+    );
 }
 
 // Issue 16: nothing the editor lets you do may produce a file it cannot open again. Each
@@ -1244,7 +1493,9 @@ fn ctrl_s(h: &mut Harness<'static, TracelabApp>) {
 /// The saved file, opened again as tracelab opens files.
 fn reopened(path: &Path) -> tracelab_core::Scene {
     let out = tracelab_core::load_scene(path, &mut MeshCache::new());
-    out.into_result().unwrap_or_else(|d| panic!("the saved file does not open:\n{d}")).0
+    out.into_result()
+        .unwrap_or_else(|d| panic!("the saved file does not open:\n{d}"))
+        .0
 }
 
 fn sphere_radius(scene: &tracelab_core::Scene) -> f32 {
@@ -1269,11 +1520,21 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
     h.get_by_label("TriangleMesh").click();
     h.step();
     h.step();
-    let Some(Selection::Node(mesh)) = h.state().doc.selection else { panic!("the new mesh is selected") };
+    let Some(Selection::Node(mesh)) = h.state().doc.selection else {
+        panic!("the new mesh is selected")
+    };
     ctrl_s(&mut h);
-    assert_eq!(std::fs::read_to_string(&path).expect("read"), before, "Save wrote a file with no obj_file");
+    assert_eq!(
+        std::fs::read_to_string(&path).expect("read"),
+        before,
+        "Save wrote a file with no obj_file"
+    );
     let msg = h.state().doc.messages.join("\n");
-    assert!(msg.contains("not saved") && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)), "{msg}");
+    assert!(
+        msg.contains("not saved")
+            && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)),
+        "{msg}"
+    );
     // The explanation is on screen, and the tree shows the node in red (its row has an error).
     let _ = h.get_by_label_contains("not saved; first fix");
     let rows = tracelab::gui::panels::tree::tree_rows(&h.state().doc.scene);
@@ -1288,12 +1549,20 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
     select_row(&mut h, "Sphere: (0, 0, 0) r 1");
     for text in ["nan", "1e39"] {
         type_into(&mut h, "radius", text);
-        assert_eq!(sphere_radius(&h.state().doc.scene), 1.0, "{text} was stored as the radius");
+        assert_eq!(
+            sphere_radius(&h.state().doc.scene),
+            1.0,
+            "{text} was stored as the radius"
+        );
         // Beside the field, the inspector says why.
         let _ = h.get_by_label("radius must be a finite number");
     }
     type_into(&mut h, "radius", "0.5");
-    assert_eq!(sphere_radius(&h.state().doc.scene), 0.5, "a valid value still goes in");
+    assert_eq!(
+        sphere_radius(&h.state().doc.scene),
+        0.5,
+        "a valid value still goes in"
+    );
     ctrl_s(&mut h);
     assert_eq!(sphere_radius(&reopened(&path)), 0.5);
 }
@@ -1311,7 +1580,11 @@ fn scale_y_zero_on_the_squashed_sphere_is_refused_and_ctrl_s_leaves_a_file_that_
         NodeKind::Transform(ops) => ops.first().cloned(),
         _ => None,
     });
-    assert_eq!(scale, Some(TransformOp::Scale(Vec3::new(1.0, 0.2, 1.0))), "the last valid Scale is kept");
+    assert_eq!(
+        scale,
+        Some(TransformOp::Scale(Vec3::new(1.0, 0.2, 1.0))),
+        "the last valid Scale is kept"
+    );
 }
 
 #[test]
@@ -1322,7 +1595,10 @@ fn an_orthographic_size_of_zero_is_refused_and_the_saved_file_opens() {
     type_into(&mut h, "size", "0");
     let _ = h.get_by_label("OrthographicCamera: size must be positive, found 0");
     ctrl_s(&mut h);
-    assert!(matches!(reopened(&path).camera, tracelab_core::Camera::Orthographic { size: 2.5, .. }));
+    assert!(matches!(
+        reopened(&path).camera,
+        tracelab_core::Camera::Orthographic { size: 2.5, .. }
+    ));
 }
 
 #[test]
@@ -1334,9 +1610,16 @@ fn a_camera_direction_parallel_to_up_is_refused_and_the_saved_file_opens() {
     type_into(&mut h, "direction y", "1");
     type_into(&mut h, "direction z", "0");
     let _ = h.get_by_label("OrthographicCamera: up must not be zero or parallel to direction");
-    assert_eq!(h.state().doc.scene.camera.direction(), Vec3::new(0.0, 1.0, -1.0), "the last valid direction");
+    assert_eq!(
+        h.state().doc.scene.camera.direction(),
+        Vec3::new(0.0, 1.0, -1.0),
+        "the last valid direction"
+    );
     ctrl_s(&mut h);
-    assert_eq!(reopened(&path).camera.direction(), Vec3::new(0.0, 1.0, -1.0));
+    assert_eq!(
+        reopened(&path).camera.direction(),
+        Vec3::new(0.0, 1.0, -1.0)
+    );
 }
 
 #[test]
@@ -1348,9 +1631,15 @@ fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
         type_into(&mut h, &format!("direction {axis}"), "0");
     }
     let _ = h.get_by_label("DirectionalLight: direction must not be zero");
-    assert_eq!(h.state().doc.scene.lights()[0].direction, Vec3::new(0.0, 0.0, -1.0));
+    assert_eq!(
+        h.state().doc.scene.lights()[0].direction,
+        Vec3::new(0.0, 0.0, -1.0)
+    );
     ctrl_s(&mut h);
-    assert_eq!(reopened(&path).lights()[0].direction, Vec3::new(0.0, 0.0, -1.0));
+    assert_eq!(
+        reopened(&path).lights()[0].direction,
+        Vec3::new(0.0, 0.0, -1.0)
+    );
 }
 
 #[test]

@@ -17,11 +17,23 @@ fn harness(size: (u32, u32)) -> Harness<'static, TracelabApp> {
     Harness::builder()
         .with_size(egui::vec2(1200.0, 760.0))
         .with_max_steps(10_000)
-        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: None, fixed_size: Some(size), ..AppOptions::default() }))
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: None,
+                    fixed_size: Some(size),
+                    ..AppOptions::default()
+                },
+            )
+        })
 }
 
 fn depth_t_index() -> usize {
-    tracelab::gui::lecture::FIGURES.iter().position(|f| f.file == "depth_t.txt").expect("in the menu")
+    tracelab::gui::lecture::FIGURES
+        .iter()
+        .position(|f| f.file == "depth_t.txt")
+        .expect("in the menu")
 }
 
 #[test]
@@ -35,7 +47,14 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
     h.get_by_label("What to do about the depth t").click();
     settle(&mut h);
     let app = h.state();
-    assert!(app.doc.path.as_ref().is_some_and(|p| p.ends_with("depth_t.txt")), "{:?}", app.doc.path);
+    assert!(
+        app.doc
+            .path
+            .as_ref()
+            .is_some_and(|p| p.ends_with("depth_t.txt")),
+        "{:?}",
+        app.doc.path
+    );
     assert_eq!(app.view.object_rays, ObjectRays::NormalizedNoRescale);
     assert_eq!(app.lecture, Some(depth_t_index()));
     let _ = h.get_by_label_contains("the big blue sphere jumps in front");
@@ -47,11 +66,20 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
         let f = p.frames[0].lock();
         f.get(28, 23).expect("pixel").color
     });
-    assert!(centre[2] > centre[0], "blue in front under the bug: {centre:?}");
+    assert!(
+        centre[2] > centre[0],
+        "blue in front under the bug: {centre:?}"
+    );
     // The toolbar's switch back to the lecture's rule: red in front again.
     h.state_mut().view.object_rays = ObjectRays::Unnormalized;
     settle(&mut h);
-    let centre = h.state().worker.with_published(|p| p.expect("published").frames[0].lock().get(28, 23).expect("pixel").color);
+    let centre = h.state().worker.with_published(|p| {
+        p.expect("published").frames[0]
+            .lock()
+            .get(28, 23)
+            .expect("pixel")
+            .color
+    });
     assert!(centre[0] > centre[2], "red in front: {centre:?}");
     // Opening another file drops the caption.
     h.state_mut().queue(AppCommand::New);
@@ -63,7 +91,8 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
 fn the_ray_panel_draws_both_spaces_for_the_picked_pixel_and_can_be_hidden() {
     let mut h = harness((48, 48));
     settle(&mut h);
-    h.state_mut().queue(AppCommand::OpenLecture(depth_t_index()));
+    h.state_mut()
+        .queue(AppCommand::OpenLecture(depth_t_index()));
     settle(&mut h);
     h.state_mut().view.object_rays = ObjectRays::Unnormalized;
     settle(&mut h);
@@ -85,7 +114,8 @@ fn the_ray_panel_draws_both_spaces_for_the_picked_pixel_and_can_be_hidden() {
 fn an_animation_exported_from_the_editor_writes_every_frame() {
     let mut h = harness((24, 24));
     settle(&mut h);
-    h.state_mut().queue(AppCommand::OpenLecture(depth_t_index()));
+    h.state_mut()
+        .queue(AppCommand::OpenLecture(depth_t_index()));
     settle(&mut h);
     let (id, _) = h
         .state()
@@ -98,7 +128,11 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     h.state_mut().doc.select(Some(Selection::Node(id)));
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
-    assert!(h.state().animation.is_some(), "{:?}", h.state().doc.messages);
+    assert!(
+        h.state().animation.is_some(),
+        "{:?}",
+        h.state().doc.messages
+    );
     let dir = std::env::temp_dir().join(format!("tracelab-lecture-gui-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut form = h.state().animation.clone().expect("form");
@@ -110,15 +144,29 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     let start = Instant::now();
     loop {
         h.step();
-        if h.state().animation_running.is_none() && h.state().doc.messages.iter().any(|m| m.contains("animation") || m.contains("exported")) {
+        if h.state().animation_running.is_none()
+            && h.state()
+                .doc
+                .messages
+                .iter()
+                .any(|m| m.contains("animation") || m.contains("exported"))
+        {
             break;
         }
-        assert!(start.elapsed() < Duration::from_secs(60), "export did not finish");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "export did not finish"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     let msg = h.state().doc.messages.last().cloned().unwrap_or_default();
     assert!(msg.starts_with("exported 3 frames"), "{msg}");
-    for f in ["frame_0000.png", "frame_0001.png", "frame_0002.png", "frame.apng.png"] {
+    for f in [
+        "frame_0000.png",
+        "frame_0001.png",
+        "frame_0002.png",
+        "frame.apng.png",
+    ] {
         assert!(PathBuf::from(&dir).join(f).is_file(), "{f}");
     }
     // Without a Transform selected the dialog is refused with a reason.
@@ -127,5 +175,11 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
     assert!(h.state().animation.is_none());
-    assert!(h.state().doc.messages.iter().any(|m| m.contains("select a Transform first")));
+    assert!(
+        h.state()
+            .doc
+            .messages
+            .iter()
+            .any(|m| m.contains("select a Transform first"))
+    );
 }

@@ -43,7 +43,16 @@ fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
     let mut h = Harness::builder()
         .with_size(vec2(1200.0, 760.0))
         .with_max_steps(10_000)
-        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(SIZE), ..AppOptions::default() }));
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: Some(scene),
+                    fixed_size: Some(SIZE),
+                    ..AppOptions::default()
+                },
+            )
+        });
     settle(&mut h);
     h
 }
@@ -60,17 +69,31 @@ fn view(h: &Harness<'static, TracelabApp>) -> OnScreen {
 }
 
 fn press(h: &mut Harness<'static, TracelabApp>, button: PointerButton, at: Pos2, pressed: bool) {
-    h.event(Event::PointerButton { pos: at, button, pressed, modifiers: Modifiers::NONE });
+    h.event(Event::PointerButton {
+        pos: at,
+        button,
+        pressed,
+        modifiers: Modifiers::NONE,
+    });
     h.step();
 }
 
 /// Presses `button` at `from`, moves to `to` in `steps` steps; releases when `release`.
-fn drag(h: &mut Harness<'static, TracelabApp>, button: PointerButton, from: Pos2, to: Pos2, steps: usize, release: bool) {
+fn drag(
+    h: &mut Harness<'static, TracelabApp>,
+    button: PointerButton,
+    from: Pos2,
+    to: Pos2,
+    steps: usize,
+    release: bool,
+) {
     h.event(Event::PointerMoved(from));
     h.step();
     press(h, button, from, true);
     for k in 1..=steps {
-        h.event(Event::PointerMoved(from + (to - from) * (k as f32 / steps as f32)));
+        h.event(Event::PointerMoved(
+            from + (to - from) * (k as f32 / steps as f32),
+        ));
         h.step();
     }
     if release {
@@ -80,7 +103,10 @@ fn drag(h: &mut Harness<'static, TracelabApp>, button: PointerButton, from: Pos2
 
 fn node_where(h: &Harness<'static, TracelabApp>, f: impl Fn(&NodeKind) -> bool) -> NodeId {
     let g = &h.state().doc.scene.graph;
-    g.preorder().into_iter().find(|&id| f(&g.node(id).kind)).expect("such a node")
+    g.preorder()
+        .into_iter()
+        .find(|&id| f(&g.node(id).kind))
+        .expect("such a node")
 }
 
 fn sphere(h: &Harness<'static, TracelabApp>) -> NodeId {
@@ -88,12 +114,17 @@ fn sphere(h: &Harness<'static, TracelabApp>) -> NodeId {
 }
 
 fn select(h: &mut Harness<'static, TracelabApp>, id: NodeId) {
-    h.state_mut().queue(AppCommand::Select(Some(Selection::Node(id))));
+    h.state_mut()
+        .queue(AppCommand::Select(Some(Selection::Node(id))));
     settle(h);
 }
 
 fn angle_between(a: Vec3, b: Vec3) -> f32 {
-    a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos().to_degrees()
+    a.normalize()
+        .dot(b.normalize())
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees()
 }
 
 #[test]
@@ -105,21 +136,47 @@ fn a_middle_drag_orbits_by_04_degrees_per_point_about_the_point_under_the_pointe
     // The sphere's front, under the pointer: the pivot.
     let pivot = Vec3::new(0.0, 0.0, 1.0);
     let pivot_on_screen = v.project(pivot).expect("visible");
-    drag(&mut h, PointerButton::Middle, from, from + vec2(100.0, 0.0), 10, true);
+    drag(
+        &mut h,
+        PointerButton::Middle,
+        from,
+        from + vec2(100.0, 0.0),
+        10,
+        true,
+    );
     let after = camera(&h);
     let turned = angle_between(before.direction(), after.direction());
-    assert!((turned - 40.0).abs() < 0.05, "turned {turned}°, expected 100 points × 0.4°");
+    assert!(
+        (turned - 40.0).abs() < 0.05,
+        "turned {turned}°, expected 100 points × 0.4°"
+    );
     // The scene turns with the pointer: its near side goes right, so the camera goes left
     // and looks a little towards +x.
-    assert!(after.direction().x > 0.0 && after.center().x < 0.0, "{after:?}");
+    assert!(
+        after.direction().x > 0.0 && after.center().x < 0.0,
+        "{after:?}"
+    );
     assert_eq!(after.up(), before.up(), "turntable: up stays as written");
     let still = view(&h).project(pivot).expect("visible");
-    assert!((still - pivot_on_screen).length() < 1.5, "the pivot stays under the pointer: {pivot_on_screen:?} → {still:?}");
+    assert!(
+        (still - pivot_on_screen).length() < 1.5,
+        "the pivot stays under the pointer: {pivot_on_screen:?} → {still:?}"
+    );
     // A vertical drag tilts about the screen's right axis, without rolling.
-    drag(&mut h, PointerButton::Middle, from, from + vec2(0.0, 50.0), 5, true);
+    drag(
+        &mut h,
+        PointerButton::Middle,
+        from,
+        from + vec2(0.0, 50.0),
+        5,
+        true,
+    );
     let tilted = camera(&h);
     assert!((angle_between(after.direction(), tilted.direction()) - 20.0).abs() < 0.05);
-    assert!(ViewBasis::new(&tilted, 10, 10).horizontal.y.abs() < 1e-5, "no roll");
+    assert!(
+        ViewBasis::new(&tilted, 10, 10).horizontal.y.abs() < 1e-5,
+        "no roll"
+    );
 }
 
 #[test]
@@ -128,13 +185,23 @@ fn an_orbit_drag_is_one_undo_step_that_restores_the_exact_camera_and_save_writes
     let mut h = harness(path.clone());
     let before = camera(&h);
     let from = view(&h).rect.center();
-    drag(&mut h, PointerButton::Middle, from, from + vec2(-70.0, 30.0), 12, true);
+    drag(
+        &mut h,
+        PointerButton::Middle,
+        from,
+        from + vec2(-70.0, 30.0),
+        12,
+        true,
+    );
     settle(&mut h);
     let moved = camera(&h);
     assert_ne!(moved, before);
     // Save writes the new camera in the course's form.
     h.state_mut().save();
-    let saved = tracelab_core::load_scene(&path, &mut MeshCache::new()).into_result().expect("reads back").0;
+    let saved = tracelab_core::load_scene(&path, &mut MeshCache::new())
+        .into_result()
+        .expect("reads back")
+        .0;
     assert_eq!(saved.camera, moved);
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
@@ -148,7 +215,14 @@ fn alt_left_drag_orbits_too_and_shift_middle_drag_pans_with_the_pointer() {
     let before = camera(&h);
     let from = view(&h).rect.center();
     h.event(Event::ModifiersChanged(Modifiers::ALT));
-    drag(&mut h, PointerButton::Primary, from, from + vec2(50.0, 0.0), 5, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        from,
+        from + vec2(50.0, 0.0),
+        5,
+        true,
+    );
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     settle(&mut h);
     assert!((angle_between(before.direction(), camera(&h).direction()) - 20.0).abs() < 0.05);
@@ -159,18 +233,38 @@ fn alt_left_drag_orbits_too_and_shift_middle_drag_pans_with_the_pointer() {
     let front = Vec3::new(0.0, 0.0, 1.0);
     let at = v.project(front).expect("visible");
     h.event(Event::ModifiersChanged(Modifiers::SHIFT));
-    drag(&mut h, PointerButton::Middle, at, at + vec2(40.0, -25.0), 5, true);
+    drag(
+        &mut h,
+        PointerButton::Middle,
+        at,
+        at + vec2(40.0, -25.0),
+        5,
+        true,
+    );
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     settle(&mut h);
-    assert_eq!(camera(&h).direction(), before.direction(), "a pan does not turn");
+    assert_eq!(
+        camera(&h).direction(),
+        before.direction(),
+        "a pan does not turn"
+    );
     let now = view(&h).project(front).expect("visible");
-    assert!((now - (at + vec2(40.0, -25.0))).length() < 1.5, "{at:?} → {now:?}");
+    assert!(
+        (now - (at + vec2(40.0, -25.0))).length() < 1.5,
+        "{at:?} → {now:?}"
+    );
 }
 
 fn wheel(h: &mut Harness<'static, TracelabApp>, at: Pos2, lines: f32) {
     h.event(Event::PointerMoved(at));
     h.step();
-    h.event(Event::MouseWheel { unit: egui::MouseWheelUnit::Line, delta: vec2(0.0, lines), phase: egui::TouchPhase::Move, source: egui::MouseWheelSource::Wheel, modifiers: Modifiers::NONE });
+    h.event(Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Line,
+        delta: vec2(0.0, lines),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Wheel,
+        modifiers: Modifiers::NONE,
+    });
     h.step();
 }
 
@@ -181,7 +275,10 @@ fn the_wheel_dollies_the_perspective_camera_and_sizes_the_orthographic_one() {
     wheel(&mut h, at, 1.0);
     // Towards the sphere's front (z = 1): the distance 9 becomes 9 / 1.2.
     let c = camera(&h).center();
-    assert!((c.z - (1.0 + 9.0 / 1.2)).abs() < 0.05 && c.x.abs() < 0.05, "{c}");
+    assert!(
+        (c.z - (1.0 + 9.0 / 1.2)).abs() < 0.05 && c.x.abs() < 0.05,
+        "{c}"
+    );
     wheel(&mut h, at, -2.0);
     let c = camera(&h).center();
     assert!((c.z - (1.0 + 9.0 * 1.2)).abs() < 0.1, "{c}");
@@ -190,7 +287,12 @@ fn the_wheel_dollies_the_perspective_camera_and_sizes_the_orthographic_one() {
     let mut h = harness(scene_file("wheel-ortho", SPHERE, ortho));
     let at = view(&h).rect.center();
     wheel(&mut h, at, 1.0);
-    let Camera::Orthographic { size, direction, .. } = camera(&h) else { panic!("still orthographic") };
+    let Camera::Orthographic {
+        size, direction, ..
+    } = camera(&h)
+    else {
+        panic!("still orthographic")
+    };
     assert!((size - 5.0 / 1.2).abs() < 1e-4, "{size}");
     assert_eq!(direction, Vec3::NEG_Z);
 }
@@ -207,7 +309,11 @@ fn corners((lo, hi): (Vec3, Vec3)) -> impl Iterator<Item = Vec3> {
 
 fn inside_the_image(h: &Harness<'static, TracelabApp>, b: (Vec3, Vec3)) -> bool {
     let basis = ViewBasis::new(&camera(h), SIZE.0, SIZE.1);
-    corners(b).all(|c| basis.project(c).is_some_and(|p| p.x > 0.0 && p.y > 0.0 && p.x < SIZE.0 as f32 && p.y < SIZE.1 as f32))
+    corners(b).all(|c| {
+        basis
+            .project(c)
+            .is_some_and(|p| p.x > 0.0 && p.y > 0.0 && p.x < SIZE.0 as f32 && p.y < SIZE.1 as f32)
+    })
 }
 
 #[test]
@@ -216,22 +322,40 @@ fn f_frames_the_selection_home_frames_all_and_7_looks_down() {
     let mut h = harness(scene_file("frame", objects, PERSPECTIVE));
     let s = sphere(&h);
     let bounds = tracelab::gui::bounds::world_bounds(&h.state().doc.scene, s).expect("bounded");
-    assert!(!inside_the_image(&h, bounds), "the test needs the sphere out of view at first");
+    assert!(
+        !inside_the_image(&h, bounds),
+        "the test needs the sphere out of view at first"
+    );
     select(&mut h, s);
     h.key_press(egui::Key::F);
     settle(&mut h);
-    assert!(inside_the_image(&h, bounds), "F frames the selection: {:?}", camera(&h));
-    assert_eq!(camera(&h).direction(), Vec3::NEG_Z, "framing keeps the direction");
+    assert!(
+        inside_the_image(&h, bounds),
+        "F frames the selection: {:?}",
+        camera(&h)
+    );
+    assert_eq!(
+        camera(&h).direction(),
+        Vec3::NEG_Z,
+        "framing keeps the direction"
+    );
     // The picture shows it: red pixels in the middle of the image.
     let shown = h.state().shown();
     let img = &shown[0];
     let mid = (SIZE.1 as usize / 2) * SIZE.0 as usize + SIZE.0 as usize / 2;
-    assert!(img.image.pixels[mid].r() > 100 && img.image.pixels[mid].g() < 30, "{:?}", img.image.pixels[mid]);
+    assert!(
+        img.image.pixels[mid].r() > 100 && img.image.pixels[mid].g() < 30,
+        "{:?}",
+        img.image.pixels[mid]
+    );
 
     h.key_press(egui::Key::Num7);
     settle(&mut h);
     let c = camera(&h);
-    assert!(matches!(c, Camera::Perspective { angle, .. } if angle == 30.0), "keeps the camera type");
+    assert!(
+        matches!(c, Camera::Perspective { angle, .. } if angle == 30.0),
+        "keeps the camera type"
+    );
     assert_eq!((c.direction(), c.up()), (Vec3::NEG_Y, Vec3::NEG_Z));
     let root = h.state().doc.scene.graph.root();
     let all = tracelab::gui::bounds::world_bounds(&h.state().doc.scene, root).expect("bounded");
@@ -245,7 +369,10 @@ fn red_centroid(h: &Harness<'static, TracelabApp>) -> glam::Vec2 {
     let (mut sum, mut n) = (glam::Vec2::ZERO, 0.0);
     for (i, c) in img.pixels.iter().enumerate() {
         if c.r() > 40 && c.g() < 20 {
-            sum += glam::Vec2::new((i % img.size[0]) as f32 + 0.5, (i / img.size[0]) as f32 + 0.5);
+            sum += glam::Vec2::new(
+                (i % img.size[0]) as f32 + 0.5,
+                (i / img.size[0]) as f32 + 0.5,
+            );
             n += 1.0;
         }
     }
@@ -271,28 +398,56 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     let grab = gizmo_point(&h, Handle::Move(0));
     let axis_on_screen = (v.project(centre + Vec3::X).expect("visible") - c0).normalized();
     let n = 60.0;
-    drag(&mut h, PointerButton::Primary, grab, grab + axis_on_screen * n, 6, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + axis_on_screen * n,
+        6,
+        true,
+    );
     settle(&mut h);
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(h.state().doc.scene.graph.parents()[s.index()].expect("parent")).kind else {
+    let NodeKind::Transform(ops) = &h
+        .state()
+        .doc
+        .scene
+        .graph
+        .node(h.state().doc.scene.graph.parents()[s.index()].expect("parent"))
+        .kind
+    else {
         panic!("the sphere's parent is still its Transform")
     };
-    let TransformOp::Translate(t) = ops[0] else { panic!("{ops:?}") };
+    let TransformOp::Translate(t) = ops[0] else {
+        panic!("{ops:?}")
+    };
     assert_eq!((t.y, t.z), (0.0, 0.0), "only x moves");
     let centre1 = tracelab::gui::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
     let c1 = view(&h).project(centre1).expect("visible");
     let moved = c1 - c0;
-    assert!((moved - axis_on_screen * n).length() < 1.0, "the centre moved {moved:?} for {n} points along {axis_on_screen:?}");
+    assert!(
+        (moved - axis_on_screen * n).length() < 1.0,
+        "the centre moved {moved:?} for {n} points along {axis_on_screen:?}"
+    );
     // In the op's units that is a fifth of the world distance.
     let world = (centre1 - centre).length();
-    assert!(((t.x - 0.1) * 5.0 - world).abs() < 1e-4, "{t} for {world} world units");
+    assert!(
+        ((t.x - 0.1) * 5.0 - world).abs() < 1e-4,
+        "{t} for {world} world units"
+    );
     // And the picture shows it there: the red pixels moved by as many image pixels.
     let drawn = red_centroid(&h) - drawn0;
     let expected = n / (v.rect.width() / SIZE.0 as f32);
-    assert!((drawn.x - expected).abs() < 1.0 && drawn.y.abs() < 1.0, "drawn moved {drawn} px, expected {expected}");
+    assert!(
+        (drawn.x - expected).abs() < 1.0 && drawn.y.abs() < 1.0,
+        "drawn moved {drawn} px, expected {expected}"
+    );
     // One undo step, exact.
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
-    assert_eq!(tracelab::gui::bounds::world_centre(&h.state().doc.scene, s), Some(centre));
+    assert_eq!(
+        tracelab::gui::bounds::world_centre(&h.state().doc.scene, s),
+        Some(centre)
+    );
 }
 
 #[test]
@@ -302,35 +457,88 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
     let s = sphere(&h);
     select(&mut h, s);
     let grab = gizmo_point(&h, Handle::Move(1));
-    drag(&mut h, PointerButton::Primary, grab, grab + vec2(0.0, -30.0), 4, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + vec2(0.0, -30.0),
+        4,
+        true,
+    );
     settle(&mut h);
     let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else { panic!("a Transform") };
-    assert!(matches!(ops.as_slice(), [TransformOp::Translate(v), TransformOp::Scale(_)] if v.y > 0.0 && v.x == 0.0), "{ops:?}");
-    let note = h.state().note.as_ref().map(|n| n.0.clone()).unwrap_or_default();
+    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+        panic!("a Transform")
+    };
+    assert!(
+        matches!(ops.as_slice(), [TransformOp::Translate(v), TransformOp::Scale(_)] if v.y > 0.0 && v.x == 0.0),
+        "{ops:?}"
+    );
+    let note = h
+        .state()
+        .note
+        .as_ref()
+        .map(|n| n.0.clone())
+        .unwrap_or_default();
     assert!(note.contains("added Translate as op 1"), "{note}");
     // The ring adds its ZRotate after the Translate, before the Scale.
     let grab = gizmo_point(&h, Handle::Rotate);
-    drag(&mut h, PointerButton::Primary, grab, grab + vec2(0.0, 25.0), 4, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + vec2(0.0, 25.0),
+        4,
+        true,
+    );
     settle(&mut h);
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else { panic!("a Transform") };
-    assert!(matches!(ops.as_slice(), [TransformOp::Translate(_), TransformOp::ZRotate(d), TransformOp::Scale(_)] if *d != 0.0), "{ops:?}");
+    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+        panic!("a Transform")
+    };
+    assert!(
+        matches!(ops.as_slice(), [TransformOp::Translate(_), TransformOp::ZRotate(d), TransformOp::Scale(_)] if *d != 0.0),
+        "{ops:?}"
+    );
 
     let mut h = harness(scene_file("wrap", SPHERE, PERSPECTIVE));
     let s = sphere(&h);
     select(&mut h, s);
     let before = h.state().doc.scene.clone();
     let grab = gizmo_point(&h, Handle::Scale(0));
-    drag(&mut h, PointerButton::Primary, grab, grab + vec2(20.0, 0.0), 4, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + vec2(20.0, 0.0),
+        4,
+        true,
+    );
     settle(&mut h);
     let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else { panic!("wrapped in a Transform") };
-    assert!(matches!(ops.as_slice(), [TransformOp::Scale(v)] if v.x > 1.0 && v.y == 1.0 && v.z == 1.0), "{ops:?}");
-    let note = h.state().note.as_ref().map(|n| n.0.clone()).unwrap_or_default();
-    assert!(note.contains("wrapped the Sphere in a new Transform with Scale"), "{note}");
+    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+        panic!("wrapped in a Transform")
+    };
+    assert!(
+        matches!(ops.as_slice(), [TransformOp::Scale(v)] if v.x > 1.0 && v.y == 1.0 && v.z == 1.0),
+        "{ops:?}"
+    );
+    let note = h
+        .state()
+        .note
+        .as_ref()
+        .map(|n| n.0.clone())
+        .unwrap_or_default();
+    assert!(
+        note.contains("wrapped the Sphere in a new Transform with Scale"),
+        "{note}"
+    );
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
-    assert_eq!(h.state().doc.scene, before, "one undo takes the Transform away again");
+    assert_eq!(
+        h.state().doc.scene,
+        before,
+        "one undo takes the Transform away again"
+    );
 }
 
 #[test]
@@ -340,7 +548,14 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
     select(&mut h, s);
     let before = h.state().doc.scene.clone();
     let grab = gizmo_point(&h, Handle::Move(0));
-    drag(&mut h, PointerButton::Primary, grab, grab + vec2(45.0, 0.0), 5, false);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + vec2(45.0, 0.0),
+        5,
+        false,
+    );
     assert_ne!(h.state().doc.scene, before, "the drag moved it");
     h.key_press(egui::Key::Escape);
     h.step();
@@ -348,29 +563,62 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
     // The rest of that press moves nothing.
     h.event(Event::PointerMoved(grab + vec2(80.0, 0.0)));
     h.step();
-    press(&mut h, PointerButton::Primary, grab + vec2(80.0, 0.0), false);
+    press(
+        &mut h,
+        PointerButton::Primary,
+        grab + vec2(80.0, 0.0),
+        false,
+    );
     settle(&mut h);
     assert_eq!(h.state().doc.scene, before);
-    assert!(!h.state().doc.can_undo(), "nothing to undo after a cancelled drag");
+    assert!(
+        !h.state().doc.can_undo(),
+        "nothing to undo after a cancelled drag"
+    );
     // With Ctrl, the Translate lands on a multiple of 0.1 (in the op's own units).
     h.event(Event::ModifiersChanged(Modifiers::COMMAND));
-    drag(&mut h, PointerButton::Primary, grab, grab + vec2(63.0, 0.0), 5, true);
+    drag(
+        &mut h,
+        PointerButton::Primary,
+        grab,
+        grab + vec2(63.0, 0.0),
+        5,
+        true,
+    );
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     settle(&mut h);
     let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else { panic!("a Transform") };
-    let TransformOp::Translate(v) = ops[0] else { panic!("{ops:?}") };
-    assert!(((v.x * 10.0).round() - v.x * 10.0).abs() < 1e-4 && v.x > 0.15, "{v}");
+    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+        panic!("a Transform")
+    };
+    let TransformOp::Translate(v) = ops[0] else {
+        panic!("{ops:?}")
+    };
+    assert!(
+        ((v.x * 10.0).round() - v.x * 10.0).abs() < 1e-4 && v.x > 0.15,
+        "{v}"
+    );
 }
 
 #[test]
 fn a_drag_renders_coarse_passes_while_the_pointer_moves_and_refines_when_it_stops() {
     let mut h = harness(scene_file("coarse", SPHERE, PERSPECTIVE));
     let from = view(&h).rect.center();
-    drag(&mut h, PointerButton::Middle, from, from + vec2(30.0, 0.0), 3, false);
+    drag(
+        &mut h,
+        PointerButton::Middle,
+        from,
+        from + vec2(30.0, 0.0),
+        3,
+        false,
+    );
     assert!(h.state().worker.coarse_only, "moving: coarse passes only");
     let start = Instant::now();
-    while !h.state().worker.with_published(|p| p.is_some_and(|p| p.job.coarse && p.full.is_some())) {
+    while !h
+        .state()
+        .worker
+        .with_published(|p| p.is_some_and(|p| p.job.coarse && p.full.is_some()))
+    {
         h.step();
         assert!(start.elapsed() < Duration::from_secs(20));
     }
@@ -380,7 +628,13 @@ fn a_drag_renders_coarse_passes_while_the_pointer_moves_and_refines_when_it_stop
     h.state().worker.with_published(|p| {
         let p = p.expect("published");
         // Four passes, or fewer where a quick coarse pass went straight to the full one.
-        assert!(!p.job.coarse && p.full.is_some() && (2..=4).contains(&p.passes) && p.passes_done == p.passes, "refined");
+        assert!(
+            !p.job.coarse
+                && p.full.is_some()
+                && (2..=4).contains(&p.passes)
+                && p.passes_done == p.passes,
+            "refined"
+        );
         assert_eq!(p.job.generation, h.state().doc.generation);
     });
     press(&mut h, PointerButton::Middle, from + vec2(30.0, 0.0), false);

@@ -10,7 +10,11 @@ use glam::{DMat3, DMat4, DVec3};
 use serde_json::Value;
 
 fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab")).args(args).current_dir(dir).output().expect("run tracelab")
+    Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run tracelab")
 }
 
 fn repo() -> PathBuf {
@@ -41,7 +45,11 @@ fn inspect_json(scene: &str, args: &[&str]) -> Value {
 fn vec3(v: &Value) -> DVec3 {
     let a = v.as_array().expect("array of 3");
     assert_eq!(a.len(), 3);
-    DVec3::new(a[0].as_f64().expect("n"), a[1].as_f64().expect("n"), a[2].as_f64().expect("n"))
+    DVec3::new(
+        a[0].as_f64().expect("n"),
+        a[1].as_f64().expect("n"),
+        a[2].as_f64().expect("n"),
+    )
 }
 
 fn num(v: &Value) -> f64 {
@@ -59,7 +67,10 @@ fn close(a: DVec3, b: DVec3, tol: f64, what: &str) {
 }
 
 fn close_m(a: DMat3, b: DMat3, tol: f64, what: &str) {
-    let d = (a - b).to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let d = (a - b)
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(d < tol, "{what}: {a} vs {b}");
 }
 
@@ -68,7 +79,10 @@ fn inspect_json_matches_a_hand_computed_sheared_sphere_pixel() {
     // scenes/sheared_sphere.txt, the second sphere: Translate 1.2 0 0, Matrix (x += 0.6 y),
     // Scale 0.5 1.5 0.8 on the unit sphere; orthographic camera at z = 10, size 5, looking
     // down −z; light from direction (−0.5, −0.5, −1), colour 0.9; ambient 0.1; k_d (0.9, 0.3, 0.2).
-    let j = inspect_json("scenes/sheared_sphere.txt", &["--size", "40", "40", "--pixel", "28", "18"]);
+    let j = inspect_json(
+        "scenes/sheared_sphere.txt",
+        &["--size", "40", "40", "--pixel", "28", "18"],
+    );
     assert_eq!(j["schema"], "tracelab-inspect/1");
     assert_eq!(j["pixel"]["x"], 28);
     assert_eq!(j["pixel"]["row"], 18);
@@ -78,7 +92,11 @@ fn inspect_json_matches_a_hand_computed_sheared_sphere_pixel() {
     close(vec3(&j["world_ray"]["origin"]), o, 1e-6, "origin");
     close(vec3(&j["world_ray"]["direction"]), d, 1e-7, "direction");
 
-    let lin = DMat3::from_cols(DVec3::new(0.5, 0.0, 0.0), DVec3::new(0.9, 1.5, 0.0), DVec3::new(0.0, 0.0, 0.8));
+    let lin = DMat3::from_cols(
+        DVec3::new(0.5, 0.0, 0.0),
+        DVec3::new(0.9, 1.5, 0.0),
+        DVec3::new(0.0, 0.0, 0.8),
+    );
     let m = DMat4::from_cols(
         lin.x_axis.extend(0.0),
         lin.y_axis.extend(0.0),
@@ -89,28 +107,75 @@ fn inspect_json_matches_a_hand_computed_sheared_sphere_pixel() {
     let h = &j["hit"];
     assert_eq!(h["node"]["kind"], "Sphere");
     let path = h["path"].as_array().expect("path");
-    let labels: Vec<&str> = path.iter().map(|s| s["node"]["label"].as_str().expect("label")).collect();
-    assert_eq!(labels, ["Group (2)", "Transform: Translate(1.2, 0, 0) · Matrix(4×4) · Scale(0.5, 1.5, 0.8)", "Sphere: (0, 0, 0) r 1"]);
+    let labels: Vec<&str> = path
+        .iter()
+        .map(|s| s["node"]["label"].as_str().expect("label"))
+        .collect();
+    assert_eq!(
+        labels,
+        [
+            "Group (2)",
+            "Transform: Translate(1.2, 0, 0) · Matrix(4×4) · Scale(0.5, 1.5, 0.8)",
+            "Sphere: (0, 0, 0) r 1"
+        ]
+    );
     let t = &path[1]["transform"];
     close_m(mat3(&t["M"]["linear"]), lin, 1e-6, "M");
-    close(vec3(&t["M"]["translation"]), DVec3::new(1.2, 0.0, 0.0), 1e-6, "M translation");
-    close_m(mat3(&t["M_inverse"]["linear"]), DMat3::from_mat4(inv), 1e-6, "M⁻¹");
-    close(vec3(&t["M_inverse"]["translation"]), inv.w_axis.truncate(), 1e-6, "M⁻¹ translation");
-    close_m(mat3(&t["M_inverse_transpose"]), DMat3::from_mat4(inv).transpose(), 1e-6, "(M⁻¹)ᵀ");
+    close(
+        vec3(&t["M"]["translation"]),
+        DVec3::new(1.2, 0.0, 0.0),
+        1e-6,
+        "M translation",
+    );
+    close_m(
+        mat3(&t["M_inverse"]["linear"]),
+        DMat3::from_mat4(inv),
+        1e-6,
+        "M⁻¹",
+    );
+    close(
+        vec3(&t["M_inverse"]["translation"]),
+        inv.w_axis.truncate(),
+        1e-6,
+        "M⁻¹ translation",
+    );
+    close_m(
+        mat3(&t["M_inverse_transpose"]),
+        DMat3::from_mat4(inv).transpose(),
+        1e-6,
+        "(M⁻¹)ᵀ",
+    );
     assert_eq!(t["similitude"]["is_similitude"], false);
     assert!(t["similitude"]["lambda"].is_null());
-    let kinds: Vec<&str> = t["similitude"]["breaks"].as_array().expect("breaks").iter().map(|b| b["kind"].as_str().expect("kind")).collect();
+    let kinds: Vec<&str> = t["similitude"]["breaks"]
+        .as_array()
+        .expect("breaks")
+        .iter()
+        .map(|b| b["kind"].as_str().expect("kind"))
+        .collect();
     assert_eq!(kinds, ["non_uniform_scale", "shear"]);
     assert!(path[0]["transform"].is_null() && path[2]["transform"].is_null());
 
     // Object space: o' = M⁻¹o, d' = M⁻¹d (not renormalised); |o' + t d'|² = 1, nearer root.
     let (oo, dd) = (inv.transform_point3(o), inv.transform_vector3(d));
     close(vec3(&path[2]["ray"]["origin"]), oo, 1e-5, "object origin");
-    close(vec3(&path[2]["ray"]["direction"]), dd, 1e-6, "object direction");
+    close(
+        vec3(&path[2]["ray"]["direction"]),
+        dd,
+        1e-6,
+        "object direction",
+    );
     let (a, b, c) = (dd.dot(dd), 2.0 * oo.dot(dd), oo.dot(oo) - 1.0);
     let t_hit = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
-    assert!((num(&h["t"]["world"]) - t_hit).abs() < 1e-4, "{} vs {t_hit}", h["t"]["world"]);
-    assert!((num(&h["t"]["object"]) - t_hit).abs() < 1e-4, "unnormalised: the same t");
+    assert!(
+        (num(&h["t"]["world"]) - t_hit).abs() < 1e-4,
+        "{} vs {t_hit}",
+        h["t"]["world"]
+    );
+    assert!(
+        (num(&h["t"]["object"]) - t_hit).abs() < 1e-4,
+        "unnormalised: the same t"
+    );
     assert_eq!(h["t"]["used_is"], "world");
     assert!((num(&h["t"]["object_direction_length"]) - dd.length()).abs() < 1e-6);
     let p_obj = oo + dd * t_hit;
@@ -123,7 +188,10 @@ fn inspect_json_matches_a_hand_computed_sheared_sphere_pixel() {
     close(vec3(&h["normal"]["world_correct"]), n_good, 1e-4, "(M⁻¹)ᵀn");
     close(vec3(&h["normal"]["world_incorrect"]), n_bad, 1e-4, "Mn");
     let angle = n_good.angle_between(n_bad).to_degrees();
-    assert!((num(&h["normal"]["angle_degrees"]) - angle).abs() < 1e-2, "{angle}");
+    assert!(
+        (num(&h["normal"]["angle_degrees"]) - angle).abs() < 1e-2,
+        "{angle}"
+    );
     // Shading: ambient·k_d + max(L·N, 0)·c·k_d, L toward the light.
     let kd = DVec3::new(0.9, 0.3, 0.2);
     let l = -DVec3::new(-0.5, -0.5, -1.0).normalize();
@@ -133,13 +201,33 @@ fn inspect_json_matches_a_hand_computed_sheared_sphere_pixel() {
     let color = 0.1 * kd + ln.max(0.0) * 0.9 * kd;
     close(vec3(&sh["color"]), color, 1e-4, "colour");
     close(vec3(&j["color"]), color, 1e-4, "pixel colour");
-    let bytes: Vec<u64> = j["rgb8"].as_array().expect("rgb8").iter().map(|v| v.as_u64().expect("byte")).collect();
-    let expect: Vec<u64> = color.to_array().iter().map(|c| (c * 255.0).floor() as u64).collect();
+    let bytes: Vec<u64> = j["rgb8"]
+        .as_array()
+        .expect("rgb8")
+        .iter()
+        .map(|v| v.as_u64().expect("byte"))
+        .collect();
+    let expect: Vec<u64> = color
+        .to_array()
+        .iter()
+        .map(|c| (c * 255.0).floor() as u64)
+        .collect();
     assert_eq!(bytes, expect);
     // And the rendered image has those bytes at that pixel.
     let dir = temp_dir("inspect-render");
     let scene = repo().join("scenes/sheared_sphere.txt");
-    let o = tracelab(&["render", scene.to_str().expect("utf-8"), "--size", "40", "40", "--output", "a.png"], &dir);
+    let o = tracelab(
+        &[
+            "render",
+            scene.to_str().expect("utf-8"),
+            "--size",
+            "40",
+            "40",
+            "--output",
+            "a.png",
+        ],
+        &dir,
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(dir.join("a.png")).expect("png").to_rgb8();
     assert_eq!(img.get_pixel(28, 18).0.map(u64::from).to_vec(), bytes);
@@ -153,15 +241,42 @@ fn inspect_json_says_which_t_the_bug_keeps() {
     let (x, y) = (0.65f64, 0.05f64);
     let t_blue = 14.0 - (4.0 - (x + 0.6).powi(2) - y * y).sqrt();
     let t_red = 10.0 - (1.0 - (x - 0.6).powi(2) - y * y).sqrt();
-    let good = inspect_json("scenes/lecture/depth_t.txt", &["--size", "60", "60", "--pixel", "36", "29"]);
+    let good = inspect_json(
+        "scenes/lecture/depth_t.txt",
+        &["--size", "60", "60", "--pixel", "36", "29"],
+    );
     assert!((num(&good["hit"]["t"]["world"]) - t_red).abs() < 1e-4);
-    let normalized = inspect_json("scenes/lecture/depth_t.txt", &["--size", "60", "60", "--pixel", "36", "29", "--object-rays", "normalized"]);
+    let normalized = inspect_json(
+        "scenes/lecture/depth_t.txt",
+        &[
+            "--size",
+            "60",
+            "60",
+            "--pixel",
+            "36",
+            "29",
+            "--object-rays",
+            "normalized",
+        ],
+    );
     let tn = &normalized["hit"]["t"];
     assert!((num(&tn["world"]) - t_red).abs() < 1e-4 && (num(&tn["used"]) - t_red).abs() < 1e-4);
     // UniformScale 0.5: |M⁻¹d| = 2, so the unit-direction object ray runs twice as far.
     assert!((num(&tn["object"]) - 2.0 * t_red).abs() < 1e-4, "{tn}");
     assert!((vec3(&normalized["hit"]["traced_ray"]["direction"]).length() - 1.0).abs() < 1e-6);
-    let bug = inspect_json("scenes/lecture/depth_t.txt", &["--size", "60", "60", "--pixel", "36", "29", "--object-rays", "normalized-no-rescale"]);
+    let bug = inspect_json(
+        "scenes/lecture/depth_t.txt",
+        &[
+            "--size",
+            "60",
+            "60",
+            "--pixel",
+            "36",
+            "29",
+            "--object-rays",
+            "normalized-no-rescale",
+        ],
+    );
     assert_eq!(bug["settings"]["object_rays"], "normalized-no-rescale");
     let tb = &bug["hit"]["t"];
     assert_eq!(tb["used_is"], "object");
@@ -181,19 +296,53 @@ fn inspect_text_names_rows_from_the_top_and_refuses_pixels_outside() {
     assert!(String::from_utf8_lossy(&help.stdout).contains("from the TOP"));
     let scene = repo().join("scenes/sheared_sphere.txt");
     let scene = scene.to_str().expect("utf-8");
-    let o = tracelab(&["inspect", scene, "--size", "40", "40", "--pixel", "28", "18"], &repo());
+    let o = tracelab(
+        &[
+            "inspect", scene, "--size", "40", "40", "--pixel", "28", "18",
+        ],
+        &repo(),
+    );
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
-    for want in ["row from the top", "M⁻¹", "(M⁻¹)ᵀ", "not a similitude", "world by M", "sum"] {
+    for want in [
+        "row from the top",
+        "M⁻¹",
+        "(M⁻¹)ᵀ",
+        "not a similitude",
+        "world by M",
+        "sum",
+    ] {
         assert!(text.contains(want), "{want} missing:\n{text}");
     }
-    let o = tracelab(&["inspect", scene, "--size", "40", "40", "--pixel", "40", "0"], &repo());
+    let o = tracelab(
+        &["inspect", scene, "--size", "40", "40", "--pixel", "40", "0"],
+        &repo(),
+    );
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("outside the 40×40 image"), "{}", stderr(&o));
-    let o = tracelab(&["inspect", "no-such.txt", "--size", "4", "4", "--pixel", "0", "0"], &repo());
+    assert!(
+        stderr(&o).contains("outside the 40×40 image"),
+        "{}",
+        stderr(&o)
+    );
+    let o = tracelab(
+        &[
+            "inspect",
+            "no-such.txt",
+            "--size",
+            "4",
+            "4",
+            "--pixel",
+            "0",
+            "0",
+        ],
+        &repo(),
+    );
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("no-such.txt"), "{}", stderr(&o));
-    let o = tracelab(&["inspect", scene, "--size", "0", "4", "--pixel", "0", "0"], &repo());
+    let o = tracelab(
+        &["inspect", scene, "--size", "0", "4", "--pixel", "0", "0"],
+        &repo(),
+    );
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -201,9 +350,12 @@ fn inspect_text_names_rows_from_the_top_and_refuses_pixels_outside() {
 /// `tracelab diff IMAGE -- LINE`.
 fn course_line(scene: &Path) -> Vec<String> {
     let s = scene.to_str().expect("utf-8").to_string();
-    ["-input", &s, "-size", "50", "40", "-output", "out.png", "-normals", "n.png", "-depth", "8", "11", "d.png"]
-        .map(String::from)
-        .to_vec()
+    [
+        "-input", &s, "-size", "50", "40", "-output", "out.png", "-normals", "n.png", "-depth",
+        "8", "11", "d.png",
+    ]
+    .map(String::from)
+    .to_vec()
 }
 
 fn diff(dir: &Path, image: &str, line: &[String], extra: &[&str]) -> Output {
@@ -221,17 +373,33 @@ fn diff_of_a_perfect_image_matches_and_leaves_the_students_files_alone() {
     let args: Vec<&str> = line.iter().map(String::as_str).collect();
     assert!(tracelab(&args, &dir).status.success());
     std::fs::copy(dir.join("out.png"), dir.join("mine.png")).expect("copy");
-    let before: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"].iter().map(|f| std::fs::read(dir.join(f)).expect("read")).collect();
+    let before: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"]
+        .iter()
+        .map(|f| std::fs::read(dir.join(f)).expect("read"))
+        .collect();
     let o = diff(&dir, "mine.png", &line, &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{out}{}", stderr(&o));
-    for want in ["colour mine.png: 100.00% of 2000 pixels", "normals n.png: 100.00%", "depth d.png: 100.00%", "matches"] {
+    for want in [
+        "colour mine.png: 100.00% of 2000 pixels",
+        "normals n.png: 100.00%",
+        "depth d.png: 100.00%",
+        "matches",
+    ] {
         assert!(out.contains(want), "{want} missing:\n{out}");
     }
-    let after: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"].iter().map(|f| std::fs::read(dir.join(f)).expect("read")).collect();
-    assert_eq!(before, after, "diff must not write the files the line names");
+    let after: Vec<Vec<u8>> = ["out.png", "n.png", "d.png"]
+        .iter()
+        .map(|f| std::fs::read(dir.join(f)).expect("read"))
+        .collect();
+    assert_eq!(
+        before, after,
+        "diff must not write the files the line names"
+    );
     // The heat map of a perfect image is the reference, dimmed to a quarter, in grey.
-    let map = image::open(dir.join("mine.diff.png")).expect("heat map").to_rgb8();
+    let map = image::open(dir.join("mine.diff.png"))
+        .expect("heat map")
+        .to_rgb8();
     let reference = image::open(dir.join("out.png")).expect("ref").to_rgb8();
     for (m, r) in map.pixels().zip(reference.pixels()) {
         let lum = (u32::from(r[0]) * 3 + u32::from(r[1]) * 6 + u32::from(r[2])) / 10;
@@ -247,7 +415,15 @@ fn diff_of_a_slightly_wrong_image_names_the_wrong_pixels_and_still_matches() {
     assert!(tracelab(&args, &dir).status.success());
     // Six pixels off by 30 in red, one by 90: 7 of 2000 is 0.35%, under the 1% allowed.
     let mut img = image::open(dir.join("out.png")).expect("out").to_rgb8();
-    let spots = [(10u32, 5u32, 30u8), (11, 5, 30), (12, 5, 30), (30, 20, 30), (31, 20, 30), (32, 20, 30), (36, 21, 90)];
+    let spots = [
+        (10u32, 5u32, 30u8),
+        (11, 5, 30),
+        (12, 5, 30),
+        (30, 20, 30),
+        (31, 20, 30),
+        (32, 20, 30),
+        (36, 21, 90),
+    ];
     for &(x, row, by) in &spots {
         let p = img.get_pixel_mut(x, row);
         p[0] = if p[0] >= by { p[0] - by } else { p[0] + by };
@@ -256,21 +432,48 @@ fn diff_of_a_slightly_wrong_image_names_the_wrong_pixels_and_still_matches() {
     let o = diff(&dir, "mine.png", &line, &["--worst", "3"]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(out.contains("99.65% of 2000 pixels within 8/255 (largest difference 90)"), "{out}");
+    assert!(
+        out.contains("99.65% of 2000 pixels within 8/255 (largest difference 90)"),
+        "{out}"
+    );
     // The worst first, then ties by row and column.
     let listed: Vec<&str> = out.lines().filter(|l| l.starts_with("  (")).collect();
     assert_eq!(listed.len(), 3, "{out}");
-    assert!(listed[0].starts_with("  (36, 21):") && listed[0].contains("off by 90"), "{out}");
-    assert!(listed[1].starts_with("  (10, 5):") && listed[2].starts_with("  (11, 5):"), "{out}");
+    assert!(
+        listed[0].starts_with("  (36, 21):") && listed[0].contains("off by 90"),
+        "{out}"
+    );
+    assert!(
+        listed[1].starts_with("  (10, 5):") && listed[2].starts_with("  (11, 5):"),
+        "{out}"
+    );
     // (36, 21) is on the red sheared sphere, centred at world x = 1.2 = (36.5/50 − ½)·5: its story says so, with t and the normal rule.
-    assert!(listed[0].contains("Sphere") && listed[0].contains("t = ") && listed[0].contains("normal by (M⁻¹)ᵀ"), "{}", listed[0]);
-    let map = image::open(dir.join("mine.diff.png")).expect("heat map").to_rgb8();
+    assert!(
+        listed[0].contains("Sphere")
+            && listed[0].contains("t = ")
+            && listed[0].contains("normal by (M⁻¹)ᵀ"),
+        "{}",
+        listed[0]
+    );
+    let map = image::open(dir.join("mine.diff.png"))
+        .expect("heat map")
+        .to_rgb8();
     for (x, row, p) in map.enumerate_pixels() {
         let marked = spots.iter().any(|s| (s.0, s.1) == (x, row));
-        assert_eq!(p[0] == 255 && p[2] == 0 && p[1] >= 9, marked, "({x}, {row}) {:?}", p.0);
+        assert_eq!(
+            p[0] == 255 && p[2] == 0 && p[1] >= 9,
+            marked,
+            "({x}, {row}) {:?}",
+            p.0
+        );
     }
     // A stricter grader fails it.
-    assert_eq!(diff(&dir, "mine.png", &line, &["--min-match", "99.9"]).status.code(), Some(3));
+    assert_eq!(
+        diff(&dir, "mine.png", &line, &["--min-match", "99.9"])
+            .status
+            .code(),
+        Some(3)
+    );
 }
 
 #[test]
@@ -282,23 +485,51 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
     assert!(tracelab(&args, &dir).status.success());
     // The incorrect normal rule: the classic wrong image.
     let s = scene.to_str().expect("utf-8");
-    let o = tracelab(&["-input", s, "-size", "50", "40", "-output", "wrong.png", "-normal_transform", "incorrect"], &dir);
+    let o = tracelab(
+        &[
+            "-input",
+            s,
+            "-size",
+            "50",
+            "40",
+            "-output",
+            "wrong.png",
+            "-normal_transform",
+            "incorrect",
+        ],
+        &dir,
+    );
     assert!(o.status.success());
     let o = diff(&dir, "wrong.png", &line, &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{out}");
-    assert!(out.contains("colour wrong.png:") && out.contains("does not match"), "{out}");
-    assert!(out.contains("from the other rule's"), "the worst pixels are where the rules part:\n{out}");
+    assert!(
+        out.contains("colour wrong.png:") && out.contains("does not match"),
+        "{out}"
+    );
+    assert!(
+        out.contains("from the other rule's"),
+        "the worst pixels are where the rules part:\n{out}"
+    );
     // Wrong size: said with both sizes, before any pixel.
-    let o = tracelab(&["-input", s, "-size", "40", "40", "-output", "small.png"], &dir);
+    let o = tracelab(
+        &["-input", s, "-size", "40", "40", "-output", "small.png"],
+        &dir,
+    );
     assert!(o.status.success());
     let o = diff(&dir, "small.png", &line, &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{out}");
-    assert!(out.contains("size 40×40, but the command line asks for 50×40: does not match"), "{out}");
+    assert!(
+        out.contains("size 40×40, but the command line asks for 50×40: does not match"),
+        "{out}"
+    );
     // A missing image is an error (1), a bad line a usage error (2).
     assert_eq!(diff(&dir, "absent.png", &line, &[]).status.code(), Some(1));
-    let o = tracelab(&["diff", "small.png", "--", "-input", s, "-size", "50"], &dir);
+    let o = tracelab(
+        &["diff", "small.png", "--", "-input", s, "-size", "50"],
+        &dir,
+    );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
@@ -306,29 +537,60 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
 #[ignore = "needs ../shared/mit6837"]
 fn diff_accepts_the_courses_own_reference_images() {
     let shared = repo().join("../shared/mit6837");
-    assert!(shared.join("scenes").is_dir(), "{} is missing: this test needs ../shared beside the checkout", shared.display());
+    assert!(
+        shared.join("scenes").is_dir(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        shared.display()
+    );
     let dir = temp_dir("diff-course");
     for f in ["scene2_11_squashed_sphere.txt", "scene2_16_t_scale.txt"] {
         std::fs::copy(shared.join("scenes").join(f), dir.join(f)).expect("copy scene");
     }
     for (img, line) in [
-        ("output2_11.png", "-input scene2_11_squashed_sphere.txt -size 200 200 -output x.png"),
-        ("output2_16.png", "-input scene2_16_t_scale.txt -size 200 200 -output x.png"),
+        (
+            "output2_11.png",
+            "-input scene2_11_squashed_sphere.txt -size 200 200 -output x.png",
+        ),
+        (
+            "output2_16.png",
+            "-input scene2_16_t_scale.txt -size 200 200 -output x.png",
+        ),
     ] {
         std::fs::copy(shared.join("reference").join(img), dir.join(img)).expect("copy reference");
         let line: Vec<String> = line.split(' ').map(String::from).collect();
         let o = diff(&dir, img, &line, &[]);
-        assert_eq!(o.status.code(), Some(0), "{img}: {}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{img}: {}{}",
+            String::from_utf8_lossy(&o.stdout),
+            stderr(&o)
+        );
     }
     // The depth image of scene2_16 as the bug draws it fails against the reference.
-    std::fs::copy(shared.join("reference/depth2_16.png"), dir.join("depth2_16.png")).expect("copy");
+    std::fs::copy(
+        shared.join("reference/depth2_16.png"),
+        dir.join("depth2_16.png"),
+    )
+    .expect("copy");
     let line = "-input scene2_16_t_scale.txt -size 200 200 -output bug.png -depth 2 7 bug_depth.png -object_rays normalized-no-rescale";
     let args: Vec<&str> = line.split(' ').collect();
     assert!(tracelab(&args, &dir).status.success());
-    let good: Vec<String> = "-input scene2_16_t_scale.txt -size 200 200 -output x.png -depth 2 7 bug_depth.png".split(' ').map(String::from).collect();
+    let good: Vec<String> =
+        "-input scene2_16_t_scale.txt -size 200 200 -output x.png -depth 2 7 bug_depth.png"
+            .split(' ')
+            .map(String::from)
+            .collect();
     let o = diff(&dir, "output2_16.png", &good, &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{out}");
-    assert!(out.contains("colour output2_16.png: 100.00%") || out.contains("colour output2_16.png: 99."), "{out}");
-    assert!(out.contains("depth bug_depth.png:") && out.contains("does not match"), "{out}");
+    assert!(
+        out.contains("colour output2_16.png: 100.00%")
+            || out.contains("colour output2_16.png: 99."),
+        "{out}"
+    );
+    assert!(
+        out.contains("depth bug_depth.png:") && out.contains("does not match"),
+        "{out}"
+    );
 }

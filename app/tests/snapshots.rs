@@ -8,7 +8,6 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use tracelab::gui::{AppOptions, TracelabApp};
 
-
 /// Snapshots are only comparable on the pinned backend (lavapipe via Vulkan): other
 /// backends differ in a few pixels. `.ci/run` pins it; these tests are `#[ignore]`d so a
 /// plain `cargo test` lists them, and fail here when run without it.

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab::gui::panels::viewport::Shown;
+use tracelab::gui::{AppOptions, TracelabApp};
 
 /// Scaled in y only and turned, so the two normal rules differ visibly.
 const SQUASHED: &str = "
@@ -44,7 +44,16 @@ fn harness(scene: &Path, size: (u32, u32)) -> Harness<'static, TracelabApp> {
     Harness::builder()
         .with_size(egui::vec2(1200.0, 760.0))
         .with_max_steps(10_000)
-        .build_eframe(move |cc| TracelabApp::new(Some(cc), AppOptions { scene: Some(scene), fixed_size: Some(size), ..AppOptions::default() }))
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: Some(scene),
+                    fixed_size: Some(size),
+                    ..AppOptions::default()
+                },
+            )
+        })
 }
 
 fn click(h: &mut Harness<'static, TracelabApp>, label: &str) {
@@ -57,11 +66,19 @@ fn click(h: &mut Harness<'static, TracelabApp>, label: &str) {
 fn cli(scene: &Path, size: [usize; 2], view: &str, depth: (f32, f32), flags: &[&str]) -> Vec<u8> {
     let out = scene.with_file_name(format!("cli-{view}-{}.png", flags.join("_")));
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_tracelab"));
-    cmd.arg("render").arg(scene).arg("--size").arg(size[0].to_string()).arg(size[1].to_string());
+    cmd.arg("render")
+        .arg(scene)
+        .arg("--size")
+        .arg(size[0].to_string())
+        .arg(size[1].to_string());
     match view {
         "color" => cmd.arg("-o").arg(&out),
         "normals" => cmd.arg("--normals").arg(&out),
-        _ => cmd.arg("--depth").arg(depth.0.to_string()).arg(depth.1.to_string()).arg(&out),
+        _ => cmd
+            .arg("--depth")
+            .arg(depth.0.to_string())
+            .arg(depth.1.to_string())
+            .arg(&out),
     };
     let status = cmd.args(flags).status().expect("run tracelab render");
     assert!(status.success(), "tracelab render failed");
@@ -87,13 +104,24 @@ fn each_view_tab_shows_what_the_command_line_renders() {
     settle(&mut h);
     let depth = h.state().view.depth;
     let mut seen = Vec::new();
-    for (tab, view) in [("Normals", "normals"), ("Depth", "depth"), ("Colour", "color")] {
+    for (tab, view) in [
+        ("Normals", "normals"),
+        ("Depth", "depth"),
+        ("Colour", "color"),
+    ] {
         click(&mut h, tab);
         let s = single(&h);
-        assert_eq!(s.rgb8(), cli(&scene, s.size(), view, depth, &[]), "the {tab} tab");
+        assert_eq!(
+            s.rgb8(),
+            cli(&scene, s.size(), view, depth, &[]),
+            "the {tab} tab"
+        );
         seen.push(s.rgb8());
     }
-    assert!(seen[0] != seen[1] && seen[1] != seen[2] && seen[0] != seen[2], "the tabs show the same picture");
+    assert!(
+        seen[0] != seen[1] && seen[1] != seen[2] && seen[0] != seen[2],
+        "the tabs show the same picture"
+    );
 }
 
 #[test]
@@ -106,7 +134,11 @@ fn all_three_shows_colour_normals_and_depth_as_the_command_line_renders_them() {
     let s = shown(&h);
     assert_eq!(s.len(), 3);
     for (s, view) in s.iter().zip(["color", "normals", "depth"]) {
-        assert_eq!(s.rgb8(), cli(&scene, s.size(), view, depth, &[]), "the {view} cell");
+        assert_eq!(
+            s.rgb8(),
+            cli(&scene, s.size(), view, depth, &[]),
+            "the {view} cell"
+        );
     }
     // Side by side, left to right, none over another.
     assert!(s[0].rect.max.x <= s[1].rect.min.x && s[1].rect.max.x <= s[2].rect.min.x);
@@ -121,13 +153,38 @@ fn the_normal_switch_shows_each_rule_as_the_command_line_renders_it() {
     for (tab, view) in [("Normals", "normals"), ("Colour", "color")] {
         click(&mut h, tab);
         let correct = single(&h).rgb8();
-        assert_eq!(correct, cli(&scene, [40, 40], view, depth, &["--normal-transform", "correct"]));
+        assert_eq!(
+            correct,
+            cli(
+                &scene,
+                [40, 40],
+                view,
+                depth,
+                &["--normal-transform", "correct"]
+            )
+        );
         click(&mut h, "Incorrect M");
         let incorrect = single(&h).rgb8();
-        assert_ne!(incorrect, correct, "Incorrect M changed nothing in the {tab} view");
-        assert_eq!(incorrect, cli(&scene, [40, 40], view, depth, &["--normal-transform", "incorrect"]));
+        assert_ne!(
+            incorrect, correct,
+            "Incorrect M changed nothing in the {tab} view"
+        );
+        assert_eq!(
+            incorrect,
+            cli(
+                &scene,
+                [40, 40],
+                view,
+                depth,
+                &["--normal-transform", "incorrect"]
+            )
+        );
         click(&mut h, "Correct (M^-1)^T");
-        assert_eq!(single(&h).rgb8(), correct, "Correct restores the {tab} picture");
+        assert_eq!(
+            single(&h).rgb8(),
+            correct,
+            "Correct restores the {tab} picture"
+        );
     }
 }
 
@@ -162,7 +219,10 @@ fn the_depth_range_maps_depth_as_the_command_line_does() {
     settle(&mut h);
     assert_eq!(h.state().view.depth, (9.0, 10.5));
     let after = single(&h).rgb8();
-    assert_ne!(after, before, "the new depth range changed nothing on screen");
+    assert_ne!(
+        after, before,
+        "the new depth range changed nothing on screen"
+    );
     assert_eq!(after, cli(&scene, [40, 40], "depth", (9.0, 10.5), &[]));
 }
 
@@ -187,7 +247,11 @@ fn fixed_size_renders_the_size_asked_for_and_off_follows_the_view() {
     assert!(s.rect.width() <= w as f32 + 0.5 && s.rect.height() <= hh as f32 + 0.5);
     assert_eq!(s.rgb8(), cli(&scene, [w, hh], "color", depth, &[]));
     click(&mut h, "fixed size");
-    assert_eq!(single(&h).size(), [200, 200], "the handout's size by default");
+    assert_eq!(
+        single(&h).size(),
+        [200, 200],
+        "the handout's size by default"
+    );
 }
 
 fn choose_compare(h: &mut Harness<'static, TracelabApp>, mode: &str) {
@@ -209,8 +273,26 @@ fn side_by_side_shows_both_rules_as_the_command_line_renders_them() {
     let depth = h.state().view.depth;
     let s = shown(&h);
     assert_eq!(s.len(), 2);
-    assert_eq!(s[0].rgb8(), cli(&scene, s[0].size(), "normals", depth, &["--normal-transform", "correct"]));
-    assert_eq!(s[1].rgb8(), cli(&scene, s[1].size(), "normals", depth, &["--normal-transform", "incorrect"]));
+    assert_eq!(
+        s[0].rgb8(),
+        cli(
+            &scene,
+            s[0].size(),
+            "normals",
+            depth,
+            &["--normal-transform", "correct"]
+        )
+    );
+    assert_eq!(
+        s[1].rgb8(),
+        cli(
+            &scene,
+            s[1].size(),
+            "normals",
+            depth,
+            &["--normal-transform", "incorrect"]
+        )
+    );
     assert!(s[0].rect.max.x <= s[1].rect.min.x, "the cells overlap");
     choose_compare(&mut h, "off");
     assert_eq!(shown(&h).len(), 1);
@@ -226,8 +308,32 @@ fn split_shows_the_correct_rule_left_of_the_line_and_the_incorrect_right() {
     let depth = h.state().view.depth;
     let s = shown(&h);
     assert_eq!(s.len(), 2, "two halves");
-    assert_eq!(s[0].rgb8(), cli(&scene, s[0].size(), "normals", depth, &["--normal-transform", "correct"]));
-    assert_eq!(s[1].rgb8(), cli(&scene, s[1].size(), "normals", depth, &["--normal-transform", "incorrect"]));
-    assert_eq!((s[0].uv.min.x, s[0].uv.max.x, s[1].uv.min.x, s[1].uv.max.x), (0.0, 0.5, 0.5, 1.0));
-    assert!((s[0].rect.max.x - s[1].rect.min.x).abs() < 0.01, "the halves meet at the line");
+    assert_eq!(
+        s[0].rgb8(),
+        cli(
+            &scene,
+            s[0].size(),
+            "normals",
+            depth,
+            &["--normal-transform", "correct"]
+        )
+    );
+    assert_eq!(
+        s[1].rgb8(),
+        cli(
+            &scene,
+            s[1].size(),
+            "normals",
+            depth,
+            &["--normal-transform", "incorrect"]
+        )
+    );
+    assert_eq!(
+        (s[0].uv.min.x, s[0].uv.max.x, s[1].uv.min.x, s[1].uv.max.x),
+        (0.0, 0.5, 0.5, 1.0)
+    );
+    assert!(
+        (s[0].rect.max.x - s[1].rect.min.x).abs() < 0.01,
+        "the halves meet at the line"
+    );
 }

@@ -9,18 +9,18 @@ pub mod render;
 pub mod scene;
 pub mod simd;
 
-pub use format::{
-    Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, load_scene_unresolved, parse_scene,
-    parse_scene_unresolved, rebase_mesh_paths, resolve_meshes, try_write_scene, write_scene,
-};
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
+pub use format::{
+    Diagnostic, Diagnostics, ParseOutcome, Severity, SourceFile, load_scene, load_scene_unresolved,
+    parse_scene, parse_scene_unresolved, rebase_mesh_paths, resolve_meshes, try_write_scene,
+    write_scene,
+};
 pub use render::{
-    CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View, compile, render_frame,
-    render_progressive,
+    CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View,
+    compile, render_frame, render_progressive,
 };
 pub use scene::{
-    DEFAULT_MATERIAL_COLOR,
-    Anchor, Background, Comments, SceneComments, Camera, CsgOp, Graph, Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId,
-    NodeKind, Scene, TransformOp, Invalid, Place, Problem, check_scene,
+    Anchor, Background, Camera, Comments, CsgOp, DEFAULT_MATERIAL_COLOR, Graph, Invalid, Light,
+    Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId, NodeKind, Place, Problem, Scene,
+    SceneComments, TransformOp, check_scene,
 };
-

@@ -44,12 +44,20 @@ fn choose(asked: Option<&str>, cpu: Level) -> Level {
         Some("sse") => Level::Sse,
         Some("avx") => Level::Avx,
         Some(other) => {
-            eprintln!("tracelab: TRACELAB_SIMD={other:?} is not one of sse, avx; using {}", cpu.name());
+            eprintln!(
+                "tracelab: TRACELAB_SIMD={other:?} is not one of sse, avx; using {}",
+                cpu.name()
+            );
             return cpu;
         }
     };
     if wanted > cpu {
-        eprintln!("tracelab: TRACELAB_SIMD={} but this CPU has only {}; using {}", wanted.name(), cpu.name(), cpu.name());
+        eprintln!(
+            "tracelab: TRACELAB_SIMD={} but this CPU has only {}; using {}",
+            wanted.name(),
+            cpu.name(),
+            cpu.name()
+        );
         return cpu;
     }
     wanted

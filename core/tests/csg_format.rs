@@ -15,11 +15,19 @@ Materials {\n    numMaterials 2\n    Material { diffuseColor 1 0 0 }\n    Materi
 const HEAD_LINES: u32 = 11;
 
 fn parse_in(text: &str, dir: &Path) -> ParseOutcome {
-    parse_scene(text.as_bytes(), "scene.txt", Some(dir), &mut MeshCache::new())
+    parse_scene(
+        text.as_bytes(),
+        "scene.txt",
+        Some(dir),
+        &mut MeshCache::new(),
+    )
 }
 
 fn parse(text: &str) -> ParseOutcome {
-    parse_in(text, &Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes"))
+    parse_in(
+        text,
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes"),
+    )
 }
 
 fn parse_ok(text: &str) -> Scene {
@@ -53,8 +61,17 @@ fn box_and_csg_nodes_read_into_the_graph_with_their_operands_materials() {
     assert_eq!(g.node(csg).kind, NodeKind::Csg(CsgOp::Subtraction));
     let ops = &g.node(csg).children;
     assert_eq!(ops.len(), 2);
-    assert_eq!(g.node(ops[0]).kind, NodeKind::Box { min: Vec3::new(-1.0, -2.0, -3.0), max: Vec3::new(1.0, 2.0, 3.0) });
-    assert_eq!((g.node(ops[0]).material, g.node(ops[1]).material), (Some(0), Some(1)));
+    assert_eq!(
+        g.node(ops[0]).kind,
+        NodeKind::Box {
+            min: Vec3::new(-1.0, -2.0, -3.0),
+            max: Vec3::new(1.0, 2.0, 3.0)
+        }
+    );
+    assert_eq!(
+        (g.node(ops[0]).material, g.node(ops[1]).material),
+        (Some(0), Some(1))
+    );
     assert_eq!(g.node(csg).kind.name(), "Subtraction");
     assert!(g.node(csg).kind.is_container());
 }
@@ -70,7 +87,14 @@ fn every_operand_kind_reads_and_the_scene_round_trips() {
     assert!(!uses_only_course_grammar(&s));
     let (text, back) = round_trip(&s);
     assert_eq!(back, s, "read → write → read changed the scene:\n{text}");
-    for word in ["Union {", "Intersection {", "Subtraction {", "Box {", "min 0 0 0", "max 0.5 0.5 0.5"] {
+    for word in [
+        "Union {",
+        "Intersection {",
+        "Subtraction {",
+        "Box {",
+        "min 0 0 0",
+        "max 0.5 0.5 0.5",
+    ] {
         assert!(text.contains(word), "written text lacks {word:?}:\n{text}");
     }
     // A CSG block has no numObjects (it always holds two).
@@ -88,10 +112,14 @@ fn extensions_are_written_only_when_used() {
     assert!(uses_only_course_grammar(&s));
     let text = write_scene(&s);
     for word in ["Box", "Union", "Intersection", "Subtraction"] {
-        assert!(!text.contains(word), "{word} written for a course-only scene:\n{text}");
+        assert!(
+            !text.contains(word),
+            "{word} written for a course-only scene:\n{text}"
+        );
     }
-    let with_box =
-        parse_ok(&format!("{HEAD}Group {{\n numObjects 1\n MaterialIndex 0\n Box {{ min 0 0 0 max 1 1 1 }}\n}}\n"));
+    let with_box = parse_ok(&format!(
+        "{HEAD}Group {{\n numObjects 1\n MaterialIndex 0\n Box {{ min 0 0 0 max 1 1 1 }}\n}}\n"
+    ));
     assert!(!uses_only_course_grammar(&with_box));
 }
 
@@ -103,33 +131,61 @@ Group {\n  Material { diffuseColor 0 0 1 }\n  Group {\n    Sphere { center 0 0 0
   Group {\n    Material { diffuseColor 0.5 0.3 0.1 }\n    Sphere { center 4 0 0 radius 1 }\n  }\n  Material { diffuseColor 1 0 0 }\n  Plane { normal 0 1 0 offset -1 }\n}\n";
     let s = parse_ok(slide);
     let diffuse: Vec<Vec3> = s.materials.iter().map(|m| m.diffuse).collect();
-    assert_eq!(diffuse, [Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.5, 0.3, 0.1), Vec3::new(1.0, 0.0, 0.0)]);
+    assert_eq!(
+        diffuse,
+        [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.5, 0.3, 0.1),
+            Vec3::new(1.0, 0.0, 0.0)
+        ]
+    );
     // Each object renders with the material placed before it, at whatever level.
     let eff = s.graph.effective_materials();
-    let leaves: Vec<Option<u32>> =
-        s.graph.iter().filter(|(_, n)| !n.kind.is_container()).map(|(id, _)| eff[id.index()]).collect();
+    let leaves: Vec<Option<u32>> = s
+        .graph
+        .iter()
+        .filter(|(_, n)| !n.kind.is_container())
+        .map(|(id, _)| eff[id.index()])
+        .collect();
     assert_eq!(leaves, [Some(0), Some(0), Some(1), Some(2)]);
-    assert!(uses_only_course_grammar(&s), "the shorthand is not an extension of what is written");
+    assert!(
+        uses_only_course_grammar(&s),
+        "the shorthand is not an extension of what is written"
+    );
 
     let (text, back) = round_trip(&s);
     assert_eq!(back, s, "{text}");
     assert!(text.contains("Materials {\n    numMaterials 3\n"), "{text}");
     // Every Material sits in the Materials block; Groups count their objects.
     let materials_block_end = text.find("\n}\n\nGroup").expect("Materials then Group");
-    assert!(!text[materials_block_end..].contains("Material {"), "{text}");
+    assert!(
+        !text[materials_block_end..].contains("Material {"),
+        "{text}"
+    );
     assert_eq!(text.matches("numObjects").count(), 3, "{text}");
-    assert!(text.contains("numObjects 3\n    MaterialIndex 0\n"), "{text}");
+    assert!(
+        text.contains("numObjects 3\n    MaterialIndex 0\n"),
+        "{text}"
+    );
     assert!(text.contains("MaterialIndex 2\n    Plane"), "{text}");
 }
 
 #[test]
 fn csg_with_other_than_two_operands_is_an_error_at_its_keyword() {
-    let e = errors("Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n");
-    assert_eq!(e, ["4:2: Union needs exactly two operand objects (nest them for more), found 1"]);
+    let e = errors(
+        "Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
+    );
+    assert_eq!(
+        e,
+        ["4:2: Union needs exactly two operand objects (nest them for more), found 1"]
+    );
     let e = errors(
         "Group {\n numObjects 1\n MaterialIndex 0\n Intersection {\n  Sphere { center 0 0 0 radius 1 }\n  Sphere { center 1 0 0 radius 1 }\n  Sphere { center 2 0 0 radius 1 }\n }\n}\n",
     );
-    assert_eq!(e, ["4:2: Intersection needs exactly two operand objects (nest them for more), found 3"]);
+    assert_eq!(
+        e,
+        ["4:2: Intersection needs exactly two operand objects (nest them for more), found 3"]
+    );
 }
 
 #[test]
@@ -139,13 +195,18 @@ fn a_lone_triangle_or_a_group_operand_is_an_error_at_the_operand() {
     );
     assert_eq!(
         e,
-        ["8:4: a lone Triangle is not a solid, so it cannot be an operand of Subtraction (use a closed TriangleMesh)"]
+        [
+            "8:4: a lone Triangle is not a solid, so it cannot be an operand of Subtraction (use a closed TriangleMesh)"
+        ]
     );
     let e = errors(
         "Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Group { numObjects 0 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
     );
     assert_eq!(e.len(), 1, "{e:?}");
-    assert!(e[0].starts_with("5:3: a Group cannot be an operand of Union"), "{e:?}");
+    assert!(
+        e[0].starts_with("5:3: a Group cannot be an operand of Union"),
+        "{e:?}"
+    );
 }
 
 #[test]
@@ -169,10 +230,19 @@ fn an_open_mesh_operand_is_an_error_naming_the_open_edge_and_a_closed_one_is_not
         "{}",
         e[0]
     );
-    assert!(e[0].message.ends_with("belongs to 1 triangle(s), not 2"), "{}", e[0]);
+    assert!(
+        e[0].message.ends_with("belongs to 1 triangle(s), not 2"),
+        "{}",
+        e[0]
+    );
     // The same open mesh outside CSG is fine: it is a surface, not a solid.
-    let plain = "Group {\n numObjects 1\n MaterialIndex 0\n TriangleMesh { obj_file open_box.obj }\n}\n";
-    assert!(!parse_in(&format!("{HEAD}{plain}"), &dir).diagnostics.has_errors());
+    let plain =
+        "Group {\n numObjects 1\n MaterialIndex 0\n TriangleMesh { obj_file open_box.obj }\n}\n";
+    assert!(
+        !parse_in(&format!("{HEAD}{plain}"), &dir)
+            .diagnostics
+            .has_errors()
+    );
     let _ = std::fs::remove_dir_all(&dir);
     // The course cube (quads split into triangles) is closed.
     let closed = "Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n  TriangleMesh { obj_file ../assets/cube.obj }\n }\n}\n";
@@ -195,9 +265,17 @@ fn unknown_keyword_and_unterminated_csg_are_reported() {
         "Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n  Sphre { center 0 0 0 radius 1 }\n }\n}\n",
     );
     assert_eq!(e.len(), 1, "{e:?}");
-    assert!(e[0].starts_with("6:3: unknown keyword \"Sphre\" in Union"), "{e:?}");
-    let e = errors("Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n");
-    assert_eq!(e, ["4:8: unterminated Union block: expected \"}\" before the end of the file"]);
+    assert!(
+        e[0].starts_with("6:3: unknown keyword \"Sphre\" in Union"),
+        "{e:?}"
+    );
+    let e = errors(
+        "Group {\n numObjects 1\n MaterialIndex 0\n Union {\n  Sphere { center 0 0 0 radius 1 }\n",
+    );
+    assert_eq!(
+        e,
+        ["4:8: unterminated Union block: expected \"}\" before the end of the file"]
+    );
 }
 
 #[test]
@@ -205,7 +283,10 @@ fn deeply_nested_csg_neither_overflows_nor_fails() {
     let depth = 20_000;
     let mut text = format!("{HEAD}Group {{\n numObjects 1\n MaterialIndex 0\n");
     for i in 0..depth {
-        text.push_str(&format!("Union {{ Sphere {{ center {} 0 0 radius 1 }}\n", i % 7));
+        text.push_str(&format!(
+            "Union {{ Sphere {{ center {} 0 0 radius 1 }}\n",
+            i % 7
+        ));
     }
     text.push_str("Box { min 0 0 0 max 1 1 1 }\n");
     for _ in 0..depth {
@@ -218,7 +299,9 @@ fn deeply_nested_csg_neither_overflows_nor_fails() {
     // Compiling and tracing the 20 001-leaf tree is iterative too.
     let scene = tracelab_core::compile(&s);
     let ray = tracelab_core::geometry::Ray::new(Vec3::new(0.0, 0.0, 10.0), Vec3::NEG_Z);
-    let hit = scene.intersect(&ray, 0.0, f32::INFINITY).expect("the union is hit");
+    let hit = scene
+        .intersect(&ray, 0.0, f32::INFINITY)
+        .expect("the union is hit");
     assert!((hit.t - 9.0).abs() < 1e-5, "{}", hit.t);
 }
 
@@ -232,15 +315,24 @@ fn transform_ops_in_braces_read_as_on_the_slides_and_are_written_bare() {
     ));
     assert_eq!(braced, bare);
     let text = write_scene(&braced);
-    assert!(text.contains("ZRotate 45\n") && text.contains("Translate -2 0 0\n"), "{text}");
+    assert!(
+        text.contains("ZRotate 45\n") && text.contains("Translate -2 0 0\n"),
+        "{text}"
+    );
     let e = errors(
         "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  Translate { -2 0 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
     );
-    assert_eq!(e, ["5:20: expected 3 numbers after \"Translate\", found \"}\""]);
+    assert_eq!(
+        e,
+        ["5:20: expected 3 numbers after \"Translate\", found \"}\""]
+    );
     let e = errors(
         "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  ZRotate { 45 1 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
     );
-    assert_eq!(e, ["5:16: expected \"}\" to close ZRotate after 1 number(s), found \"1\""]);
+    assert_eq!(
+        e,
+        ["5:16: expected \"}\" to close ZRotate after 1 number(s), found \"1\""]
+    );
 }
 
 /// Deterministic xorshift, so failures reproduce.
@@ -253,15 +345,30 @@ fn no_mutated_csg_scene_panics_and_clean_ones_round_trip() {
          TriangleMesh {{ obj_file ../assets/cube.obj }} }} }} }} Box {{ min 0 0 0 max 1 1 1 }} }}\n"
     );
     let words: Vec<&str> = seed.split_whitespace().collect();
-    let extra =
-        ["{", "}", "Union", "Subtraction", "Box", "min", "max", "Triangle", "Group", "MaterialIndex", "Material", "1"];
+    let extra = [
+        "{",
+        "}",
+        "Union",
+        "Subtraction",
+        "Box",
+        "min",
+        "max",
+        "Triangle",
+        "Group",
+        "MaterialIndex",
+        "Material",
+        "1",
+    ];
     let mut rng = Rng(0x2545_f491_4f6c_dd1d);
     let mut clean = 0;
     for _ in 0..2000 {
         let text = mutate(&words, &extra, 2, &mut rng);
         let out = parse(&text);
         let Some(scene) = out.scene else {
-            assert!(out.diagnostics.has_errors(), "no scene and no error for {text}");
+            assert!(
+                out.diagnostics.has_errors(),
+                "no scene and no error for {text}"
+            );
             continue;
         };
         let c = tracelab_core::compile(&scene);
@@ -272,5 +379,8 @@ fn no_mutated_csg_scene_panics_and_clean_ones_round_trip() {
             assert_eq!(back, scene, "round trip changed\n{text}\ninto\n{written}");
         }
     }
-    assert!(clean >= 50, "only {clean} mutated scenes were clean: the test exercises too little");
+    assert!(
+        clean >= 50,
+        "only {clean} mutated scenes were clean: the test exercises too little"
+    );
 }

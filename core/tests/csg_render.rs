@@ -7,7 +7,8 @@ use tracelab_core::geometry::{box_face_normal, box_span};
 use tracelab_core::render::csg::{Bound, CsgTree, FLIP_BIT};
 use tracelab_core::render::{Frame, Shape};
 use tracelab_core::{
-    CompiledScene, MeshCache, NormalTransform, RenderSettings, Scene, compile, parse_scene, render_frame,
+    CompiledScene, MeshCache, NormalTransform, RenderSettings, Scene, compile, parse_scene,
+    render_frame,
 };
 
 const HEAD: &str = "PerspectiveCamera { center 2 1.5 6 direction -2 -1.5 -6 up 0 1 0 angle 35 }\n\
@@ -54,8 +55,7 @@ fn assert_close(got: &[f32], want: &[f32]) {
 }
 
 fn render(s: &Scene, w: u32, h: u32) -> Frame {
-    let settings =
-        RenderSettings::new(w, h);
+    let settings = RenderSettings::new(w, h);
     render_frame(&compile(s), &settings)
 }
 
@@ -64,7 +64,9 @@ fn differing(a: &Frame, b: &Frame) -> usize {
     a.samples
         .iter()
         .zip(&b.samples)
-        .filter(|(x, y)| x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits())
+        .filter(|(x, y)| {
+            x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits()
+        })
         .count()
 }
 
@@ -96,7 +98,10 @@ fn ray_through_two_overlapping_unit_spheres_gives_exact_intervals_per_operation(
     assert!(s.intervals(&ray).is_empty(), "A is inside B along this ray");
     // B − A: two pieces, the inner ends on A's surface.
     let (_, ba) = tree(&csg("Subtraction", B, A));
-    assert_close(&ts(&ba.intervals(&ray)), &[5.0 - hb, 5.0 - ha, 5.0 + ha, 5.0 + hb]);
+    assert_close(
+        &ts(&ba.intervals(&ray)),
+        &[5.0 - hb, 5.0 - ha, 5.0 + ha, 5.0 + hb],
+    );
 }
 
 #[test]
@@ -105,28 +110,47 @@ fn box_entry_and_exit_for_axis_and_oblique_rays() {
     let axis = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
     let (t0, f0, t1, f1) = box_span(&axis, lo, hi).expect("axis ray hits");
     assert_eq!((t0, t1), (4.0, 6.0));
-    assert_eq!((box_face_normal(f0), box_face_normal(f1)), (Vec3::Z, Vec3::NEG_Z));
+    assert_eq!(
+        (box_face_normal(f0), box_face_normal(f1)),
+        (Vec3::Z, Vec3::NEG_Z)
+    );
     // Oblique: x enters at t = 2 (x = −1), y leaves at t = 3 (y = 1), z stays inside.
     let oblique = Ray::new(Vec3::new(-3.0, -0.5, 0.0), Vec3::new(1.0, 0.5, 0.25));
     let (t0, f0, t1, f1) = box_span(&oblique, lo, hi).expect("oblique ray hits");
-    assert!((t0 - 2.0).abs() < 1e-6 && (t1 - 3.0).abs() < 1e-6, "{t0} {t1}");
-    assert_eq!((box_face_normal(f0), box_face_normal(f1)), (Vec3::NEG_X, Vec3::Y));
+    assert!(
+        (t0 - 2.0).abs() < 1e-6 && (t1 - 3.0).abs() < 1e-6,
+        "{t0} {t1}"
+    );
+    assert_eq!(
+        (box_face_normal(f0), box_face_normal(f1)),
+        (Vec3::NEG_X, Vec3::Y)
+    );
     assert!(box_span(&Ray::new(Vec3::new(-3.0, 1.5, 0.0), Vec3::X), lo, hi).is_none());
 
     // The same through a compiled Box: the nearest face, or the far one from inside.
     let c = compile(&scene("MaterialIndex 0 Box { min -1 -1 -1 max 1 1 1 }"));
     let h = c.intersect(&oblique, 0.0, f32::INFINITY).expect("hit");
     assert!((h.t - 2.0).abs() < 1e-6);
-    assert_eq!(c.world_normal(&oblique, &h, NormalTransform::Correct), Vec3::NEG_X);
-    let h = c.intersect(&oblique, 2.5, f32::INFINITY).expect("hit from inside");
+    assert_eq!(
+        c.world_normal(&oblique, &h, NormalTransform::Correct),
+        Vec3::NEG_X
+    );
+    let h = c
+        .intersect(&oblique, 2.5, f32::INFINITY)
+        .expect("hit from inside");
     assert!((h.t - 3.0).abs() < 1e-6);
-    assert_eq!(c.world_normal(&oblique, &h, NormalTransform::Correct), Vec3::Y);
+    assert_eq!(
+        c.world_normal(&oblique, &h, NormalTransform::Correct),
+        Vec3::Y
+    );
 }
 
 #[test]
 fn transformed_box_turns_its_faces() {
     // A unit box turned 90° about z: the face seen from +x was the +y face.
-    let c = compile(&scene("MaterialIndex 0 Transform { ZRotate 90 Scale 1 3 1 Box { min -1 -1 -1 max 1 1 1 } }"));
+    let c = compile(&scene(
+        "MaterialIndex 0 Transform { ZRotate 90 Scale 1 3 1 Box { min -1 -1 -1 max 1 1 1 } }",
+    ));
     let ray = Ray::new(Vec3::new(10.0, 0.0, 0.0), Vec3::NEG_X);
     let h = c.intersect(&ray, 0.0, f32::INFINITY).expect("hit");
     // Scale 3 along the box's y, which ZRotate 90 turns onto x: the face is at x = 3.
@@ -137,7 +161,10 @@ fn transformed_box_turns_its_faces() {
 #[test]
 fn transformed_csg_keeps_t_in_world_units() {
     // Scaled by 2 and moved: the spheres are radius 2 at x = −1 and x = 1, z = −3.
-    let objects = format!("Transform {{ Translate 0 0 -3 UniformScale 2 {} }}", csg("Union", A, B));
+    let objects = format!(
+        "Transform {{ Translate 0 0 -3 UniformScale 2 {} }}",
+        csg("Union", A, B)
+    );
     let (c, t) = tree(&objects);
     let ray = Ray::new(Vec3::new(-10.0, 0.0, -3.0), Vec3::X);
     assert_close(&ts(&t.intervals(&ray)), &[7.0, 13.0]);
@@ -147,13 +174,20 @@ fn transformed_csg_keeps_t_in_world_units() {
     let plain = compile(&scene(
         "MaterialIndex 0 Transform { Translate 0 0 -3 UniformScale 2 Sphere { center -0.5 0 0 radius 1 } }",
     ));
-    assert_eq!(plain.intersect(&ray, 0.0, f32::INFINITY).map(|h| h.t), Some(h.t));
+    assert_eq!(
+        plain.intersect(&ray, 0.0, f32::INFINITY).map(|h| h.t),
+        Some(h.t)
+    );
 }
 
 #[test]
 fn a_plane_operand_is_the_half_space_behind_its_normal() {
     // Sphere ∩ {y ≤ 0}: the lower hemisphere, its flat top on the plane.
-    let (c, t) = tree(&csg("Intersection", A, "MaterialIndex 1 Plane { normal 0 1 0 offset 0 }"));
+    let (c, t) = tree(&csg(
+        "Intersection",
+        A,
+        "MaterialIndex 1 Plane { normal 0 1 0 offset 0 }",
+    ));
     let down = Ray::new(Vec3::new(-0.5, 5.0, 0.0), Vec3::NEG_Y);
     assert_close(&ts(&t.intervals(&down)), &[5.0, 6.0]);
     let h = c.intersect(&down, 0.0, f32::INFINITY).expect("hit");
@@ -184,7 +218,11 @@ fn csg_surfaces_keep_their_operands_material_and_node() {
     assert!((h.t - 5.5).abs() < 1e-6, "{}", h.t);
     assert_eq!((c.hit_material(&h), c.hit_node(&h)), (1, Some(b_node)));
     assert_ne!(h.prim & FLIP_BIT, 0);
-    assert_eq!(c.world_normal(&from_right, &h, NormalTransform::Correct), Vec3::X, "faces the viewer");
+    assert_eq!(
+        c.world_normal(&from_right, &h, NormalTransform::Correct),
+        Vec3::X,
+        "faces the viewer"
+    );
 }
 
 #[test]
@@ -198,7 +236,10 @@ fn union_and_intersection_of_a_solid_with_itself_is_the_solid() {
     }
     let s = "MaterialIndex 1 Sphere { center 0 0 0 radius 1 }";
     let alone = render(&scene(s), 48, 40);
-    assert_eq!(differing(&alone, &render(&scene(&csg("Union", s, s)), 48, 40)), 0);
+    assert_eq!(
+        differing(&alone, &render(&scene(&csg("Union", s, s)), 48, 40)),
+        0
+    );
 }
 
 #[test]
@@ -232,32 +273,55 @@ fn subtractions_exposed_inner_surface_faces_the_viewer() {
     let s = scene(&csg("Subtraction", A, B));
     let c = compile(&s);
     let (w, h) = (64, 48);
-    let b_node = s.graph.node(s.graph.node(s.graph.root()).children[0]).children[1];
+    let b_node = s
+        .graph
+        .node(s.graph.node(s.graph.root()).children[0])
+        .children[1];
     let mut exposed = 0;
     for row in 0..h {
         for x in 0..w {
             let ray = c.camera.pixel_ray(x, row, w, h);
-            let Some(hit) = c.intersect(&ray, c.camera.t_min(), f32::INFINITY) else { continue };
+            let Some(hit) = c.intersect(&ray, c.camera.t_min(), f32::INFINITY) else {
+                continue;
+            };
             if c.hit_node(&hit) == Some(b_node) {
                 exposed += 1;
                 let n = c.world_normal(&ray, &hit, NormalTransform::Correct);
-                assert!(n.dot(ray.direction) < 0.0, "pixel {x},{row}: inner surface normal faces away");
+                assert!(
+                    n.dot(ray.direction) < 0.0,
+                    "pixel {x},{row}: inner surface normal faces away"
+                );
             }
         }
     }
     // The camera looks from the +x side, into the bite.
-    assert!(exposed > 100, "only {exposed} pixels show the inner surface");
+    assert!(
+        exposed > 100,
+        "only {exposed} pixels show the inner surface"
+    );
 }
 
 #[test]
 fn closed_mesh_operand_matches_the_same_box() {
     let sphere = "MaterialIndex 1 Sphere { center 0 0 0 radius 1.3 }";
     let mesh = render(
-        &scene(&csg("Intersection", "MaterialIndex 0 TriangleMesh { obj_file ../assets/cube.obj }", sphere)),
+        &scene(&csg(
+            "Intersection",
+            "MaterialIndex 0 TriangleMesh { obj_file ../assets/cube.obj }",
+            sphere,
+        )),
         64,
         48,
     );
-    let boxed = render(&scene(&csg("Intersection", "MaterialIndex 0 Box { min -1 -1 -1 max 1 1 1 }", sphere)), 64, 48);
+    let boxed = render(
+        &scene(&csg(
+            "Intersection",
+            "MaterialIndex 0 Box { min -1 -1 -1 max 1 1 1 }",
+            sphere,
+        )),
+        64,
+        48,
+    );
     assert!(hits(&boxed) > 300);
     let close = mesh
         .samples
@@ -266,10 +330,15 @@ fn closed_mesh_operand_matches_the_same_box() {
         .filter(|(m, b)| {
             m.is_hit() == b.is_hit()
                 && (!m.is_hit()
-                    || ((m.t - b.t).abs() < 1e-4 && m.color.iter().zip(b.color).all(|(p, q)| p.abs_diff(q) <= 1)))
+                    || ((m.t - b.t).abs() < 1e-4
+                        && m.color.iter().zip(b.color).all(|(p, q)| p.abs_diff(q) <= 1)))
         })
         .count();
-    assert!(close as f32 >= 0.99 * mesh.samples.len() as f32, "{close} of {} pixels agree", mesh.samples.len());
+    assert!(
+        close as f32 >= 0.99 * mesh.samples.len() as f32,
+        "{close} of {} pixels agree",
+        mesh.samples.len()
+    );
 }
 
 #[test]
@@ -277,9 +346,15 @@ fn camera_inside_a_solid_sees_the_inside_of_the_result() {
     // From the centre of A ∪ B looking along +x, the ray leaves through B at x = 1.5.
     let (c, _) = tree(&csg("Union", A, B));
     let ray = Ray::new(Vec3::ZERO, Vec3::X);
-    let h = c.intersect(&ray, 0.0, f32::INFINITY).expect("hit from inside");
+    let h = c
+        .intersect(&ray, 0.0, f32::INFINITY)
+        .expect("hit from inside");
     assert!((h.t - 1.5).abs() < 1e-6);
-    assert_eq!(c.world_normal(&ray, &h, NormalTransform::Correct), Vec3::X, "outward: a back face from inside");
+    assert_eq!(
+        c.world_normal(&ray, &h, NormalTransform::Correct),
+        Vec3::X,
+        "outward: a back face from inside"
+    );
     // Inside a big sphere with a small one taken out ahead: the ray leaves the result where
     // it enters the small sphere, and that surface's normal points on, out of the result.
     let (c, _) = tree(&csg(
@@ -287,7 +362,9 @@ fn camera_inside_a_solid_sees_the_inside_of_the_result() {
         "MaterialIndex 0 Sphere { center 0 0 0 radius 3 }",
         "MaterialIndex 1 Sphere { center 2 0 0 radius 1 }",
     ));
-    let h = c.intersect(&ray, 0.0, f32::INFINITY).expect("hit from inside");
+    let h = c
+        .intersect(&ray, 0.0, f32::INFINITY)
+        .expect("hit from inside");
     assert!((h.t - 1.0).abs() < 1e-6);
     assert_eq!(c.world_normal(&ray, &h, NormalTransform::Correct), Vec3::X);
     // With shade-back the whole view from inside is lit, as with a plain sphere.
@@ -296,27 +373,57 @@ fn camera_inside_a_solid_sees_the_inside_of_the_result() {
          Lights {{ numLights 1 DirectionalLight {{ direction 0 0 -1 color 1 1 1 }} }}\n\
          Materials {{ numMaterials 1 Material {{ diffuseColor 0.8 0.8 0.8 }} }}\n\
          Group {{ numObjects 1 MaterialIndex 0 {} }}",
-        csg("Union", "Sphere { center 0 0 -0.5 radius 2 }", "Box { min -1 -1 -1 max 1 1 1 }")
+        csg(
+            "Union",
+            "Sphere { center 0 0 -0.5 radius 2 }",
+            "Box { min -1 -1 -1 max 1 1 1 }"
+        )
     );
-    let s = parse_scene(inside.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0;
-    let settings =
-        RenderSettings { shade_back: true, ..RenderSettings::new(16, 16) };
+    let s = parse_scene(inside.as_bytes(), "t.txt", None, &mut MeshCache::new())
+        .into_result()
+        .expect("parses")
+        .0;
+    let settings = RenderSettings {
+        shade_back: true,
+        ..RenderSettings::new(16, 16)
+    };
     let f = render_frame(&compile(&s), &settings);
-    assert!(f.samples.iter().all(|p| p.is_hit() && p.t > 0.0 && p.color[0] > 30), "every pixel sees the lit inside");
+    assert!(
+        f.samples
+            .iter()
+            .all(|p| p.is_hit() && p.t > 0.0 && p.color[0] > 30),
+        "every pixel sees the lit inside"
+    );
 }
 
 #[test]
 fn csg_bounds_follow_the_operation() {
     let (_, u) = tree(&csg("Union", A, B));
-    assert_eq!((u.bounds().min, u.bounds().max), (Vec3::new(-1.5, -1.0, -1.0), Vec3::new(1.5, 1.0, 1.0)));
+    assert_eq!(
+        (u.bounds().min, u.bounds().max),
+        (Vec3::new(-1.5, -1.0, -1.0), Vec3::new(1.5, 1.0, 1.0))
+    );
     let (_, i) = tree(&csg("Intersection", A, B));
-    assert_eq!((i.bounds().min, i.bounds().max), (Vec3::new(-0.5, -1.0, -1.0), Vec3::new(0.5, 1.0, 1.0)));
+    assert_eq!(
+        (i.bounds().min, i.bounds().max),
+        (Vec3::new(-0.5, -1.0, -1.0), Vec3::new(0.5, 1.0, 1.0))
+    );
     let (_, s) = tree(&csg("Subtraction", A, B));
-    assert_eq!((s.bounds().min, s.bounds().max), (Vec3::new(-1.5, -1.0, -1.0), Vec3::new(0.5, 1.0, 1.0)));
+    assert_eq!(
+        (s.bounds().min, s.bounds().max),
+        (Vec3::new(-1.5, -1.0, -1.0), Vec3::new(0.5, 1.0, 1.0))
+    );
     // Disjoint operands intersect in nothing: the object is dropped, nothing is hit.
     let far = "MaterialIndex 1 Sphere { center 5 0 0 radius 1 }";
     let c = compile(&scene(&csg("Intersection", A, far)));
-    assert!(c.intersect(&Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z), 0.0, f32::INFINITY).is_none());
+    assert!(
+        c.intersect(
+            &Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z),
+            0.0,
+            f32::INFINITY
+        )
+        .is_none()
+    );
 }
 
 #[test]
@@ -327,20 +434,43 @@ fn normal_transform_mode_applies_to_csg_surfaces() {
     );
     let s = scene(&sheared);
     let at = |mode| {
-        render_frame(&compile(&s), &RenderSettings { normal_transform: mode, ..RenderSettings::new(64, 48) })
+        render_frame(
+            &compile(&s),
+            &RenderSettings {
+                normal_transform: mode,
+                ..RenderSettings::new(64, 48)
+            },
+        )
     };
     let (correct, incorrect) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));
     assert!(hits(&correct) > 300);
     // Same geometry, different normals.
-    assert!(correct.samples.iter().zip(&incorrect.samples).all(|(x, y)| x.t.to_bits() == y.t.to_bits()));
-    let differing = correct.samples.iter().zip(&incorrect.samples).filter(|(x, y)| x.normal != y.normal).count();
+    assert!(
+        correct
+            .samples
+            .iter()
+            .zip(&incorrect.samples)
+            .all(|(x, y)| x.t.to_bits() == y.t.to_bits())
+    );
+    let differing = correct
+        .samples
+        .iter()
+        .zip(&incorrect.samples)
+        .filter(|(x, y)| x.normal != y.normal)
+        .count();
     assert!(differing > 100, "only {differing} normals differ");
     // A similitude (rotation, uniform scale) changes nothing.
-    let similar = scene(&format!("Transform {{ ZRotate 30 UniformScale 1.5 {} }}", csg("Subtraction", A, B)));
+    let similar = scene(&format!(
+        "Transform {{ ZRotate 30 UniformScale 1.5 {} }}",
+        csg("Subtraction", A, B)
+    ));
     let at = |mode| {
         render_frame(
             &compile(&similar),
-            &RenderSettings { normal_transform: mode, ..RenderSettings::new(64, 48) },
+            &RenderSettings {
+                normal_transform: mode,
+                ..RenderSettings::new(64, 48)
+            },
         )
     };
     let (a, b) = (at(NormalTransform::Correct), at(NormalTransform::Incorrect));
@@ -350,7 +480,10 @@ fn normal_transform_mode_applies_to_csg_surfaces() {
         .zip(&b.samples)
         .flat_map(|(x, y)| (0..3).map(move |c| x.normal[c].abs_diff(y.normal[c])))
         .max();
-    assert!(worst.unwrap_or(0) <= 1, "similitudes must not change normals ({worst:?})");
+    assert!(
+        worst.unwrap_or(0) <= 1,
+        "similitudes must not change normals ({worst:?})"
+    );
 }
 
 #[test]
@@ -360,10 +493,19 @@ fn coincident_faces_give_one_consistent_surface() {
     let b = "MaterialIndex 1 Box { min 0 -1 -1 max 1 1 1 }";
     let (_, u) = tree(&csg("Union", a, b));
     // No seam where the boxes meet: one interval through both.
-    assert_close(&ts(&u.intervals(&Ray::new(Vec3::new(-5.0, 0.3, 0.2), Vec3::X))), &[4.0, 6.0]);
+    assert_close(
+        &ts(&u.intervals(&Ray::new(Vec3::new(-5.0, 0.3, 0.2), Vec3::X))),
+        &[4.0, 6.0],
+    );
     // The same box twice: its front face is one boundary, A's.
     let (c, _) = tree(&csg("Union", a, a));
-    let h = c.intersect(&Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z), 0.0, f32::INFINITY).expect("hit");
+    let h = c
+        .intersect(
+            &Ray::new(Vec3::new(-0.5, 0.0, 5.0), Vec3::NEG_Z),
+            0.0,
+            f32::INFINITY,
+        )
+        .expect("hit");
     assert_eq!(c.hit_material(&h), 0);
 
     // A box minus a slab sharing its front face: that face is gone at every pixel, and what
@@ -377,7 +519,13 @@ fn coincident_faces_give_one_consistent_surface() {
     let front = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
     let h = c.intersect(&front, 0.0, f32::INFINITY).expect("hit");
     assert!((h.t - 4.5).abs() < 1e-6, "{}", h.t);
-    assert_eq!((c.hit_material(&h), c.world_normal(&front, &h, NormalTransform::Correct)), (1, Vec3::Z));
+    assert_eq!(
+        (
+            c.hit_material(&h),
+            c.world_normal(&front, &h, NormalTransform::Correct)
+        ),
+        (1, Vec3::Z)
+    );
     let mut seen = 0;
     for row in 0..40 {
         for x in 0..48 {
@@ -385,7 +533,10 @@ fn coincident_faces_give_one_consistent_surface() {
             if let Some(h) = c.intersect(&ray, c.camera.t_min(), f32::INFINITY) {
                 seen += 1;
                 let n = c.world_normal(&ray, &h, NormalTransform::Correct);
-                assert!(n.dot(ray.direction) < 0.0, "pixel {x},{row} shows a back face");
+                assert!(
+                    n.dot(ray.direction) < 0.0,
+                    "pixel {x},{row} shows a back face"
+                );
             }
         }
     }

@@ -17,7 +17,10 @@ use std::time::Instant;
 
 use common::{Rng, fuzz_cases, mutate_text, quoted, repo};
 use tracelab_core::format::obj::{load_with_tobj, parse_obj, parse_obj_fast};
-use tracelab_core::{Frame, MeshCache, RenderSettings, Scene, check_scene, compile, parse_scene, render_frame, write_scene};
+use tracelab_core::{
+    Frame, MeshCache, RenderSettings, Scene, check_scene, compile, parse_scene, render_frame,
+    write_scene,
+};
 
 /// One case taking longer than this is a hang (cases take well under a millisecond).
 const CASE_LIMIT_MS: u64 = 20_000;
@@ -32,7 +35,9 @@ fn skip_note(msg: &str) {
 
 /// `dir`'s files ending in `ext`, recursively, sorted.
 fn files_in(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
-    let Ok(rd) = std::fs::read_dir(dir) else { return };
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return;
+    };
     let mut paths: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).collect();
     paths.sort();
     for p in paths {
@@ -56,19 +61,33 @@ fn seeds(ours: &[&str], shared: &str, ext: &str) -> Vec<(PathBuf, Vec<u8>)> {
         files_in(&shared_dir, ext, &mut paths);
     } else {
         // Not a skip: the harness still runs, on the project's own seeds.
-        skip_note(&format!("NOTE: {} not found; fuzzing our own seeds only", shared_dir.display()));
+        skip_note(&format!(
+            "NOTE: {} not found; fuzzing our own seeds only",
+            shared_dir.display()
+        ));
     }
-    paths.into_iter().filter_map(|p| std::fs::read(&p).ok().map(|b| (p, b))).collect()
+    paths
+        .into_iter()
+        .filter_map(|p| std::fs::read(&p).ok().map(|b| (p, b)))
+        .collect()
 }
 
 /// Runs cases `0..n` (or only `TRACELAB_FUZZ_CASE`) on every core, each under catch_unwind;
 /// returns the number run. `case` returns Err(why) when a property fails.
-fn run_cases(name: &str, n: u64, case: impl Fn(u64, &mut MeshCache) -> Result<(), String> + Sync) -> u64 {
-    let only: Option<u64> = std::env::var("TRACELAB_FUZZ_CASE").ok().and_then(|v| v.parse().ok());
+fn run_cases(
+    name: &str,
+    n: u64,
+    case: impl Fn(u64, &mut MeshCache) -> Result<(), String> + Sync,
+) -> u64 {
+    let only: Option<u64> = std::env::var("TRACELAB_FUZZ_CASE")
+        .ok()
+        .and_then(|v| v.parse().ok());
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
     let start = Instant::now();
     // Per thread: the case running and when it started (ms since `start`), for the watchdog.
-    let running: Vec<(AtomicU64, AtomicU64)> = (0..threads).map(|_| (AtomicU64::new(0), AtomicU64::new(0))).collect();
+    let running: Vec<(AtomicU64, AtomicU64)> = (0..threads)
+        .map(|_| (AtomicU64::new(0), AtomicU64::new(0)))
+        .collect();
     let done = AtomicBool::new(false);
     let failures: Vec<String> = std::thread::scope(|s| {
         // A hang cannot be caught: name the case, then end the run.
@@ -99,15 +118,21 @@ fn run_cases(name: &str, n: u64, case: impl Fn(u64, &mut MeshCache) -> Result<()
                     while k < n && failures.len() < 3 {
                         if only.is_none_or(|o| o == k) {
                             running[t as usize].0.store(k, Ordering::Relaxed);
-                            running[t as usize].1.store(start.elapsed().as_millis() as u64, Ordering::Relaxed);
+                            running[t as usize]
+                                .1
+                                .store(start.elapsed().as_millis() as u64, Ordering::Relaxed);
                             match catch_unwind(AssertUnwindSafe(|| case(k, &mut cache))) {
                                 Ok(Ok(())) => {}
                                 Ok(Err(why)) => failures.push(format!("case {k}: {why}")),
-                                Err(_) => failures.push(format!("case {k}: panicked (see the message above)")),
+                                Err(_) => failures
+                                    .push(format!("case {k}: panicked (see the message above)")),
                             }
                         }
                         if k > 0 && k % 1_000_000 == 0 {
-                            skip_note(&format!("{name}: {k} cases, {:.0} s", start.elapsed().as_secs_f64()));
+                            skip_note(&format!(
+                                "{name}: {k} cases, {:.0} s",
+                                start.elapsed().as_secs_f64()
+                            ));
                         }
                         k += threads;
                     }
@@ -115,12 +140,20 @@ fn run_cases(name: &str, n: u64, case: impl Fn(u64, &mut MeshCache) -> Result<()
                 })
             })
             .collect();
-        let failures =
-            handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|_| vec!["a worker died".to_string()])).collect();
+        let failures = handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| vec!["a worker died".to_string()])
+            })
+            .collect();
         done.store(true, Ordering::Relaxed);
         failures
     });
-    skip_note(&format!("{name}: {n} cases in {:.1} s on {threads} threads", start.elapsed().as_secs_f64()));
+    skip_note(&format!(
+        "{name}: {n} cases in {:.1} s on {threads} threads",
+        start.elapsed().as_secs_f64()
+    ));
     assert!(
         failures.is_empty(),
         "{name}: {} failure(s); replay one with TRACELAB_FUZZ_CASE=K\n{}",
@@ -134,7 +167,9 @@ fn differing_pixels(a: &Frame, b: &Frame) -> usize {
     a.samples
         .iter()
         .zip(&b.samples)
-        .filter(|(x, y)| x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits())
+        .filter(|(x, y)| {
+            x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits()
+        })
         .count()
 }
 
@@ -218,7 +253,11 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
         return Err("more than 20 errors shown".to_string());
     }
     let Some(scene) = out.scene else {
-        return if out.diagnostics.has_errors() { Ok(()) } else { Err("no scene and no error".to_string()) };
+        return if out.diagnostics.has_errors() {
+            Ok(())
+        } else {
+            Err("no scene and no error".to_string())
+        };
     };
     let image = render(&scene);
     if out.diagnostics.has_errors() {
@@ -229,23 +268,35 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
     // checked writer apply.
     let problems = check_scene(&scene);
     if !problems.is_empty() {
-        return Err(format!("an accepted scene breaks a validity rule: {}", problems[0]));
+        return Err(format!(
+            "an accepted scene breaks a validity rule: {}",
+            problems[0]
+        ));
     }
     let text = write_scene(&scene);
     let back = parse_scene(text.as_bytes(), "written.txt", Some(dir), cache);
     let Some(again) = back.scene.filter(|_| !back.diagnostics.has_errors()) else {
-        return Err(format!("the written scene does not read back:\n{}\n--- written:\n{text}", back.diagnostics));
+        return Err(format!(
+            "the written scene does not read back:\n{}\n--- written:\n{text}",
+            back.diagnostics
+        ));
     };
     if again != scene {
-        return Err(format!("the written scene reads as a different scene\n--- written:\n{text}"));
+        return Err(format!(
+            "the written scene reads as a different scene\n--- written:\n{text}"
+        ));
     }
     let rewritten = write_scene(&again);
     if rewritten != text {
-        return Err(format!("writing is not canonical\n--- first:\n{text}\n--- second:\n{rewritten}"));
+        return Err(format!(
+            "writing is not canonical\n--- first:\n{text}\n--- second:\n{rewritten}"
+        ));
     }
     let d = differing_pixels(&image, &render(&again));
     if d != 0 {
-        return Err(format!("the written scene renders {d} of 16 pixels differently\n--- written:\n{text}"));
+        return Err(format!(
+            "the written scene renders {d} of 16 pixels differently\n--- written:\n{text}"
+        ));
     }
     Ok(())
 }
@@ -254,7 +305,10 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
 fn mutated_scenes_never_panic_and_accepted_ones_round_trip() {
     // scenes/perf's generated 1,000-instance scene would take a third of the run for a grammar
     // the small scenes cover.
-    let seeds: Vec<_> = seeds(&["scenes"], "scenes", "txt").into_iter().filter(|(_, b)| b.len() < 64 << 10).collect();
+    let seeds: Vec<_> = seeds(&["scenes"], "scenes", "txt")
+        .into_iter()
+        .filter(|(_, b)| b.len() < 64 << 10)
+        .collect();
     assert!(seeds.len() >= 20, "only {} seed scenes", seeds.len());
     let n = fuzz_cases(100_000);
     let accepted = std::sync::atomic::AtomicU64::new(0);
@@ -263,18 +317,29 @@ fn mutated_scenes_never_panic_and_accepted_ones_round_trip() {
         let (path, seed) = &seeds[rng.below(seeds.len())];
         let input = mutate_text(seed, SCENE_WORDS, &mut rng);
         if std::env::var("TRACELAB_FUZZ_CASE").is_ok() {
-            skip_note(&format!("case {k}: seed {}\ninput {}", path.display(), quoted(&input)));
+            skip_note(&format!(
+                "case {k}: seed {}\ninput {}",
+                path.display(),
+                quoted(&input)
+            ));
         }
         let dir = path.parent().unwrap_or(Path::new("."));
         let r = scene_case(&input, dir, cache);
-        if r.is_ok() && parse_scene(&input, "fuzz.txt", Some(dir), cache).into_result().is_ok() {
+        if r.is_ok()
+            && parse_scene(&input, "fuzz.txt", Some(dir), cache)
+                .into_result()
+                .is_ok()
+        {
             accepted.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         r.map_err(|why| format!("{why}\nseed {}\ninput {}", path.display(), quoted(&input)))
     });
     // A harness whose mutations are always rejected tests only the error paths.
     let accepted = accepted.into_inner();
-    assert!(accepted * 20 >= n, "only {accepted} of {n} mutated scenes were accepted");
+    assert!(
+        accepted * 20 >= n,
+        "only {accepted} of {n} mutated scenes were accepted"
+    );
 }
 
 /// Words a mutation may insert into an OBJ file.
@@ -309,19 +374,28 @@ const OBJ_WORDS: &[&str] = &[
 /// same triangles.
 fn obj_case(input: &[u8]) -> Result<(), String> {
     let _ = parse_obj(input, "fuzz.obj");
-    let Some((fp, ft)) = parse_obj_fast(input) else { return Ok(()) };
-    let (tp, tt) =
-        load_with_tobj(input, "fuzz.obj").map_err(|e| format!("the fast reader accepts, tobj rejects: {e}"))?;
+    let Some((fp, ft)) = parse_obj_fast(input) else {
+        return Ok(());
+    };
+    let (tp, tt) = load_with_tobj(input, "fuzz.obj")
+        .map_err(|e| format!("the fast reader accepts, tobj rejects: {e}"))?;
     let as_points = |p: &[glam::Vec3], t: &[[u32; 3]]| -> Vec<[u32; 9]> {
         t.iter()
             .map(|tri| {
                 let v = tri.map(|i| p.get(i as usize).copied().unwrap_or(glam::Vec3::NAN));
-                [v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z].map(f32::to_bits)
+                [
+                    v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z,
+                ]
+                .map(f32::to_bits)
             })
             .collect()
     };
     if as_points(&fp, &ft) != as_points(&tp, &tt) {
-        return Err(format!("the readers disagree: fast {} triangles, tobj {}", ft.len(), tt.len()));
+        return Err(format!(
+            "the readers disagree: fast {} triangles, tobj {}",
+            ft.len(),
+            tt.len()
+        ));
     }
     Ok(())
 }
@@ -330,13 +404,17 @@ fn obj_case(input: &[u8]) -> Result<(), String> {
 fn mutated_obj_files_never_panic_and_both_readers_agree() {
     // The dragon and the big bunny are too slow to mutate by the thousand; the small meshes
     // cover the format.
-    let seeds: Vec<_> = seeds(&["assets"], "scenes", "obj").into_iter().filter(|(_, b)| b.len() < 64 << 10).collect();
+    let seeds: Vec<_> = seeds(&["assets"], "scenes", "obj")
+        .into_iter()
+        .filter(|(_, b)| b.len() < 64 << 10)
+        .collect();
     assert!(seeds.len() >= 3, "only {} seed meshes", seeds.len());
     let n = fuzz_cases(100_000) / 2;
     run_cases("OBJ fuzz", n, |k, _| {
         let mut rng = Rng::for_case(OBJ_SEED, k);
         let (path, seed) = &seeds[rng.below(seeds.len())];
         let input = mutate_text(seed, OBJ_WORDS, &mut rng);
-        obj_case(&input).map_err(|why| format!("{why}\nseed {}\ninput {}", path.display(), quoted(&input)))
+        obj_case(&input)
+            .map_err(|why| format!("{why}\nseed {}\ninput {}", path.display(), quoted(&input)))
     });
 }

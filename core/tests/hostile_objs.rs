@@ -11,7 +11,10 @@ use tracelab_core::format::obj::{MAX_OBJ_BYTES, load_obj};
 use tracelab_core::{MeshCache, parse_scene};
 
 fn mkfifo(path: &Path) {
-    let ok = std::process::Command::new("mkfifo").arg(path).status().is_ok_and(|s| s.success());
+    let ok = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success());
     assert!(ok, "mkfifo {}", path.display());
 }
 
@@ -21,7 +24,8 @@ fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) 
     std::thread::spawn(move || {
         let _ = tx.send(f());
     });
-    rx.recv_timeout(Duration::from_secs(secs)).expect("blocked: it did not return in time")
+    rx.recv_timeout(Duration::from_secs(secs))
+        .expect("blocked: it did not return in time")
 }
 
 /// The scene-level message for a TriangleMesh whose `obj_file` is `name` in `dir`.
@@ -33,8 +37,17 @@ fn mesh_error(dir: &Path, name: &str) -> String {
     );
     let dir = dir.to_path_buf();
     within(20, move || {
-        let out = parse_scene(text.as_bytes(), "scene.txt", Some(&dir), &mut MeshCache::new());
-        out.diagnostics.errors().map(|d| d.message.clone()).collect::<Vec<_>>().join("\n")
+        let out = parse_scene(
+            text.as_bytes(),
+            "scene.txt",
+            Some(&dir),
+            &mut MeshCache::new(),
+        );
+        out.diagnostics
+            .errors()
+            .map(|d| d.message.clone())
+            .collect::<Vec<_>>()
+            .join("\n")
     })
 }
 
@@ -44,7 +57,11 @@ fn an_mtllib_that_is_a_fifo_is_never_opened() {
     mkfifo(&dir.join("pipe.mtl"));
     // Negative indices send the file to tobj, which used to open every mtllib.
     let obj = dir.join("m.obj");
-    std::fs::write(&obj, "mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf -3 -2 -1\n").expect("write");
+    std::fs::write(
+        &obj,
+        "mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf -3 -2 -1\n",
+    )
+    .expect("write");
     let mesh = within(20, move || load_obj(&obj)).expect("loads without its materials");
     assert_eq!(mesh.triangle_count(), 1);
     let _ = std::fs::remove_dir_all(&dir);
@@ -59,7 +76,10 @@ fn a_folder_a_fifo_and_a_symlink_loop_are_named_for_what_they_are() {
     let at = |name: &str| dir.join(name).display().to_string();
     assert_eq!(
         mesh_error(&dir, "folder.obj"),
-        format!("cannot load OBJ file \"folder.obj\": {} is a folder, not an OBJ file", at("folder.obj"))
+        format!(
+            "cannot load OBJ file \"folder.obj\": {} is a folder, not an OBJ file",
+            at("folder.obj")
+        )
     );
     assert_eq!(
         mesh_error(&dir, "pipe.obj"),
@@ -87,9 +107,14 @@ fn an_obj_over_the_size_cap_is_refused_before_parsing() {
     let dir = temp_dir("cap");
     let big = dir.join("big.obj");
     // Sparse: no disk is spent on the zeros.
-    std::fs::File::create(&big).and_then(|f| f.set_len(MAX_OBJ_BYTES as u64 + 1)).expect("sparse file");
+    std::fs::File::create(&big)
+        .and_then(|f| f.set_len(MAX_OBJ_BYTES as u64 + 1))
+        .expect("sparse file");
     let e = load_obj(&big).expect_err("too big");
-    assert_eq!(e.to_string(), "the file is larger than 512 MiB, the most tracelab reads as an OBJ mesh");
+    assert_eq!(
+        e.to_string(),
+        "the file is larger than 512 MiB, the most tracelab reads as an OBJ mesh"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

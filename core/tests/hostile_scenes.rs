@@ -41,7 +41,10 @@ fn a_file_over_the_cap_is_refused_and_one_at_the_cap_is_read() {
     let d = out.diagnostics.errors().next().expect("an error");
     assert_eq!(
         d.to_string(),
-        format!("{}: the file is larger than 64 MiB, the most tracelab reads as a scene", big.display())
+        format!(
+            "{}: the file is larger than 64 MiB, the most tracelab reads as a scene",
+            big.display()
+        )
     );
     // At the cap the text is read (and then found to be NULs, not text).
     f.set_len(MAX_SCENE_BYTES as u64).expect("set_len");
@@ -57,7 +60,11 @@ fn a_flood_of_errors_stops_at_twenty_with_a_count_of_the_rest() {
     let out = parse(&text);
     let e: Vec<_> = out.diagnostics.errors().collect();
     assert_eq!(e.len(), 21, "{}", out.diagnostics);
-    assert!(e[..20].iter().all(|d| d.message == "unexpected \"}\" outside any block"));
+    assert!(
+        e[..20]
+            .iter()
+            .all(|d| d.message == "unexpected \"}\" outside any block")
+    );
     // The summary is located at the first error not shown, and still an error.
     assert_eq!(e[20].message, "… and 981 more errors");
     assert_eq!((e[20].line, e[20].col), (3, 41));
@@ -91,31 +98,63 @@ fn twenty_megabytes_of_closing_braces_give_a_short_answer() {
     let out = parse(&text);
     let shown = out.diagnostics.to_string();
     assert!(shown.len() < 4096, "{} bytes of messages", shown.len());
-    assert!(shown.contains(&format!("… and {} more errors", (20 << 20) - 20 + 2)), "{shown}");
+    assert!(
+        shown.contains(&format!("… and {} more errors", (20 << 20) - 20 + 2)),
+        "{shown}"
+    );
     assert!(start.elapsed() < Duration::from_secs(10));
 }
 
 fn errors(text: &str) -> Vec<String> {
-    parse(text).diagnostics.errors().map(|d| format!("{}:{}: {}", d.line, d.col, d.message)).collect()
+    parse(text)
+        .diagnostics
+        .errors()
+        .map(|d| format!("{}:{}: {}", d.line, d.col, d.message))
+        .collect()
 }
 
 #[test]
 fn control_bytes_from_the_input_are_escaped_in_messages() {
-    let out = parse(&format!("{HEAD}\u{1b}[2J\u{1b}]0;pwned\u{7}\nGroup {{ numObjects 0 Sph\u{b}ere {{ }} }}\n"));
+    let out = parse(&format!(
+        "{HEAD}\u{1b}[2J\u{1b}]0;pwned\u{7}\nGroup {{ numObjects 0 Sph\u{b}ere {{ }} }}\n"
+    ));
     let shown = out.diagnostics.to_string();
-    assert!(!shown.chars().any(|c| c.is_control() && c != '\n'), "{shown:?}");
-    let e: Vec<_> = out.diagnostics.errors().map(|d| d.message.clone()).collect();
-    assert!(e[0].starts_with("unknown keyword \"\\x1b[2J\\x1b]0;pwned\\x07\""), "{e:?}");
-    assert!(e[1].starts_with("unknown keyword \"Sph\\x0bere\" in Group"), "{e:?}");
+    assert!(
+        !shown.chars().any(|c| c.is_control() && c != '\n'),
+        "{shown:?}"
+    );
+    let e: Vec<_> = out
+        .diagnostics
+        .errors()
+        .map(|d| d.message.clone())
+        .collect();
+    assert!(
+        e[0].starts_with("unknown keyword \"\\x1b[2J\\x1b]0;pwned\\x07\""),
+        "{e:?}"
+    );
+    assert!(
+        e[1].starts_with("unknown keyword \"Sph\\x0bere\" in Group"),
+        "{e:?}"
+    );
 }
 
 #[test]
 fn numbers_are_quoted_as_written() {
     let group = |inner: &str| format!("{HEAD}Group {{ numObjects 1 {inner} }}\n");
-    let e = errors(&group("MaterialIndex 4294967296 Sphere { center 0 0 0 radius 1 }"));
-    assert_eq!(e, ["3:36: MaterialIndex 4294967296 is out of range: valid indices are 0 to 0"]);
-    let e = errors(&group("MaterialIndex 0 Sphere { center 0 0 0 radius 1 1e-60 }"));
-    assert_eq!(e, ["3:69: \"radius\" takes 1 number(s); found an extra \"1e-60\""]);
+    let e = errors(&group(
+        "MaterialIndex 4294967296 Sphere { center 0 0 0 radius 1 }",
+    ));
+    assert_eq!(
+        e,
+        ["3:36: MaterialIndex 4294967296 is out of range: valid indices are 0 to 0"]
+    );
+    let e = errors(&group(
+        "MaterialIndex 0 Sphere { center 0 0 0 radius 1 1e-60 }",
+    ));
+    assert_eq!(
+        e,
+        ["3:69: \"radius\" takes 1 number(s); found an extra \"1e-60\""]
+    );
 }
 
 #[test]
@@ -140,7 +179,12 @@ fn a_material_does_not_take_a_file_name() {
         "{}Materials {{ numMaterials 1 Material {{ diffuseColor 1 0 0 obj_file a.obj }} }}\nGroup {{ numObjects 0 }}\n",
         &HEAD[..HEAD.find("Materials").unwrap_or(0)]
     ));
-    assert_eq!(e, ["2:58: \"obj_file\" belongs in TriangleMesh, not in Material (material fields take numbers)"]);
+    assert_eq!(
+        e,
+        [
+            "2:58: \"obj_file\" belongs in TriangleMesh, not in Material (material fields take numbers)"
+        ]
+    );
 }
 
 /// Found by the 10M fuzz run (scene case 297022): a mesh scaled by 3.4028235e38 on one axis
@@ -155,7 +199,12 @@ fn a_mesh_under_a_huge_scale_renders_in_bounded_time() {
     );
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
-        let out = parse_scene(text.as_bytes(), "scene.txt", Some(&dir), &mut MeshCache::new());
+        let out = parse_scene(
+            text.as_bytes(),
+            "scene.txt",
+            Some(&dir),
+            &mut MeshCache::new(),
+        );
         // The validity rules now refuse the overflowing chain (with a location); the render
         // is still tried whenever a scene is accepted, and the BVH guards NaN rays itself
         // (accel's `non_finite_rays_miss_and_return`).
@@ -167,14 +216,21 @@ fn a_mesh_under_a_huge_scale_renders_in_bounded_time() {
                 );
             }
             None => assert!(
-                out.diagnostics.0.iter().any(|d| d.to_string().starts_with("scene.txt:") && d.to_string().contains("singular transform")),
+                out.diagnostics
+                    .0
+                    .iter()
+                    .any(|d| d.to_string().starts_with("scene.txt:")
+                        && d.to_string().contains("singular transform")),
                 "{}",
                 out.diagnostics
             ),
         }
         let _ = tx.send(());
     });
-    assert!(rx.recv_timeout(Duration::from_secs(20)).is_ok(), "the 4x4 render did not finish in 20 s");
+    assert!(
+        rx.recv_timeout(Duration::from_secs(20)).is_ok(),
+        "the 4x4 render did not finish in 20 s"
+    );
 }
 
 fn temp_dir(name: &str) -> PathBuf {

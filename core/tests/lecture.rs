@@ -9,7 +9,8 @@ use common::repo;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::{
-    Frame, MeshCache, NormalTransform, ObjectRays, RenderSettings, Scene, View, compile, load_scene, render_frame,
+    Frame, MeshCache, NormalTransform, ObjectRays, RenderSettings, Scene, View, compile,
+    load_scene, render_frame,
 };
 
 const SIZE: u32 = 128;
@@ -23,13 +24,30 @@ struct Figure {
     object_rays: ObjectRays,
 }
 
-const fn fig(golden: &'static str, scene: &'static str, view: View, normal_transform: NormalTransform) -> Figure {
-    Figure { golden, scene, view, normal_transform, object_rays: ObjectRays::Unnormalized }
+const fn fig(
+    golden: &'static str,
+    scene: &'static str,
+    view: View,
+    normal_transform: NormalTransform,
+) -> Figure {
+    Figure {
+        golden,
+        scene,
+        view,
+        normal_transform,
+        object_rays: ObjectRays::Unnormalized,
+    }
 }
 
 /// A figure of the depth-t question, rendered with a chosen object-ray rule.
 const fn fig_rays(golden: &'static str, scene: &'static str, object_rays: ObjectRays) -> Figure {
-    Figure { golden, scene, view: Color, normal_transform: Correct, object_rays }
+    Figure {
+        golden,
+        scene,
+        view: Color,
+        normal_transform: Correct,
+        object_rays,
+    }
 }
 
 use NormalTransform::{Correct, Incorrect};
@@ -38,14 +56,34 @@ use View::{Color, Normals};
 const FIGURES: &[Figure] = &[
     fig("simple_scene", "simple_scene", Color, Correct),
     fig("class_hierarchy", "class_hierarchy", Color, Correct),
-    fig("class_hierarchy_transforms", "class_hierarchy_transforms", Color, Correct),
+    fig(
+        "class_hierarchy_transforms",
+        "class_hierarchy_transforms",
+        Color,
+        Correct,
+    ),
     fig("nested_transforms", "nested_transforms", Color, Correct),
     fig("flat_transforms", "flat_transforms", Color, Correct),
     fig("normals", "normals", Normals, Correct),
-    fig("normal_transform_correct", "normal_transform", Color, Correct),
-    fig("normal_transform_incorrect", "normal_transform", Color, Incorrect),
+    fig(
+        "normal_transform_correct",
+        "normal_transform",
+        Color,
+        Correct,
+    ),
+    fig(
+        "normal_transform_incorrect",
+        "normal_transform",
+        Color,
+        Incorrect,
+    ),
     fig("shading_light_only", "shading_light_only", Color, Correct),
-    fig("shading_half_ambient", "shading_half_ambient", Color, Correct),
+    fig(
+        "shading_half_ambient",
+        "shading_half_ambient",
+        Color,
+        Correct,
+    ),
     fig("perspective", "perspective", Color, Correct),
     fig("cube_mesh", "cube_mesh", Color, Correct),
     fig("csg_union", "csg_union", Color, Correct),
@@ -53,7 +91,11 @@ const FIGURES: &[Figure] = &[
     fig("csg_subtraction", "csg_subtraction", Color, Correct),
     fig("csg_die", "csg_die", Color, Correct),
     fig_rays("depth_t_unnormalized", "depth_t", ObjectRays::Unnormalized),
-    fig_rays("depth_t_no_rescale", "depth_t", ObjectRays::NormalizedNoRescale),
+    fig_rays(
+        "depth_t_no_rescale",
+        "depth_t",
+        ObjectRays::NormalizedNoRescale,
+    ),
 ];
 
 fn scene_path(name: &str) -> PathBuf {
@@ -65,7 +107,11 @@ fn load(name: &str) -> Scene {
     let (scene, warnings) = load_scene(&path, &mut MeshCache::new())
         .into_result()
         .unwrap_or_else(|d| panic!("{} does not parse:\n{d}", path.display()));
-    assert!(warnings.is_empty(), "{} has warnings:\n{warnings}", path.display());
+    assert!(
+        warnings.is_empty(),
+        "{} has warnings:\n{warnings}",
+        path.display()
+    );
     scene
 }
 
@@ -74,7 +120,11 @@ fn render(scene: &Scene, normal_transform: NormalTransform) -> Frame {
 }
 
 fn render_with(scene: &Scene, normal_transform: NormalTransform, object_rays: ObjectRays) -> Frame {
-    let settings = RenderSettings { normal_transform, object_rays, ..RenderSettings::new(SIZE, SIZE) };
+    let settings = RenderSettings {
+        normal_transform,
+        object_rays,
+        ..RenderSettings::new(SIZE, SIZE)
+    };
     render_frame(&compile(scene), &settings)
 }
 
@@ -87,7 +137,10 @@ fn every_lecture_scene_has_a_figure() {
         .collect();
     files.sort();
     for f in &files {
-        assert!(FIGURES.iter().any(|g| g.scene == f), "scenes/lecture/{f}.txt has no golden image");
+        assert!(
+            FIGURES.iter().any(|g| g.scene == f),
+            "scenes/lecture/{f}.txt has no golden image"
+        );
     }
     assert!(files.len() >= 15, "{files:?}");
 }
@@ -99,19 +152,30 @@ fn lecture_scenes_match_their_reviewed_golden_images() {
     let mut failures = Vec::new();
     for f in FIGURES {
         let frame = render_with(&load(f.scene), f.normal_transform, f.object_rays);
-        assert!(frame.samples.iter().any(|s| s.is_hit()), "{}: nothing visible", f.golden);
+        assert!(
+            frame.samples.iter().any(|s| s.is_hit()),
+            "{}: nothing visible",
+            f.golden
+        );
         let rgb = frame.rgb8(f.view, (0.0, 1.0));
         let path = dir.join(format!("{}.png", f.golden));
         if update {
             std::fs::create_dir_all(&dir).expect("golden dir");
-            image::RgbImage::from_raw(SIZE, SIZE, rgb).expect("size").save(&path).expect("write golden");
+            image::RgbImage::from_raw(SIZE, SIZE, rgb)
+                .expect("size")
+                .save(&path)
+                .expect("write golden");
             eprintln!("UPDATED {} (review it before committing)", path.display());
             continue;
         }
         let golden = match image::open(&path) {
             Ok(img) => img.to_rgb8(),
             Err(e) => {
-                failures.push(format!("{}: cannot read golden {}: {e}", f.golden, path.display()));
+                failures.push(format!(
+                    "{}: cannot read golden {}: {e}",
+                    f.golden,
+                    path.display()
+                ));
                 continue;
             }
         };
@@ -121,7 +185,12 @@ fn lecture_scenes_match_their_reviewed_golden_images() {
         let mut off = 0usize;
         let mut worst = 0u8;
         for (a, b) in rgb.chunks_exact(3).zip(golden.as_raw().chunks_exact(3)) {
-            let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+            let d = a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| x.abs_diff(*y))
+                .max()
+                .unwrap_or(0);
             worst = worst.max(d);
             if d > 2 {
                 off += 1;
@@ -140,16 +209,29 @@ fn lecture_scenes_match_their_reviewed_golden_images() {
 
 #[test]
 fn nested_and_flat_lecture_transforms_give_identical_images() {
-    let (a, b) = (render(&load("nested_transforms"), Correct), render(&load("flat_transforms"), Correct));
+    let (a, b) = (
+        render(&load("nested_transforms"), Correct),
+        render(&load("flat_transforms"), Correct),
+    );
     assert!(a.samples.iter().filter(|s| s.is_hit()).count() > 1000);
-    assert!(a.samples.iter().zip(&b.samples).all(|(x, y)| x.color == y.color && x.normal == y.normal));
+    assert!(
+        a.samples
+            .iter()
+            .zip(&b.samples)
+            .all(|(x, y)| x.color == y.color && x.normal == y.normal)
+    );
 }
 
 #[test]
 fn incorrect_normal_transform_changes_the_sheared_figure() {
     let s = load("normal_transform");
     let (a, b) = (render(&s, Correct), render(&s, Incorrect));
-    let differing = a.samples.iter().zip(&b.samples).filter(|(x, y)| x.color != y.color).count();
+    let differing = a
+        .samples
+        .iter()
+        .zip(&b.samples)
+        .filter(|(x, y)| x.color != y.color)
+        .count();
     assert!(differing > 1000, "only {differing} pixels differ");
 }
 
@@ -160,13 +242,16 @@ fn shading_figures_follow_the_lecture_formula() {
     // c_light = c_ambient = 0.5: nothing exceeds k_d, and the unlit side is k_d / 2.
     let half = render(&load("shading_half_ambient"), Correct);
     let s = load("shading_half_ambient");
-    let kd_max = s.materials.iter().map(|m| m.diffuse.max_element()).fold(0.0f32, f32::max);
-    assert!(
-        half.samples
+    let kd_max = s
+        .materials
+        .iter()
+        .map(|m| m.diffuse.max_element())
+        .fold(0.0f32, f32::max);
+    assert!(half.samples.iter().filter(|p| p.is_hit()).all(|p| {
+        p.color
             .iter()
-            .filter(|p| p.is_hit())
-            .all(|p| p.color.iter().all(|&c| f32::from(c) <= kd_max * 255.0 + 1.0))
-    );
+            .all(|&c| f32::from(c) <= kd_max * 255.0 + 1.0)
+    }));
     // The lower left of the right-hand (blue) sphere faces away from the light.
     let (x, row) = (91, 74);
     let d = dark.get(x, row).expect("pixel");
@@ -174,5 +259,8 @@ fn shading_figures_follow_the_lecture_formula() {
     assert!(d.is_hit() && h.is_hit());
     assert_eq!(d.color, [0, 0, 0]);
     let kd = s.materials[2].diffuse * 0.5;
-    assert_eq!(h.color, [kd.x, kd.y, kd.z].map(tracelab_core::render::quantize));
+    assert_eq!(
+        h.color,
+        [kd.x, kd.y, kd.z].map(tracelab_core::render::quantize)
+    );
 }

@@ -54,7 +54,12 @@ const MB: usize = 1 << 20;
 #[test]
 fn a_file_of_braces_costs_little_more_than_its_size() {
     let (len, peak, msgs) = parse_peak(|| vec![b'{'; 16 * MB]);
-    assert!(peak < len, "peak {} MB for {} MB of braces", peak / MB, len / MB);
+    assert!(
+        peak < len,
+        "peak {} MB for {} MB of braces",
+        peak / MB,
+        len / MB
+    );
     assert!(msgs.len() <= 21, "{msgs:?}");
 }
 
@@ -66,10 +71,17 @@ fn a_field_of_millions_of_numbers_is_refused_not_held() {
         text.extend(b"}\n");
         text
     });
-    assert!(peak < len, "peak {} MB for {} MB of numbers", peak / MB, len / MB);
-    assert!(msgs[0].contains("\"center\" takes at most 1024 numbers"), "{msgs:?}");
+    assert!(
+        peak < len,
+        "peak {} MB for {} MB of numbers",
+        peak / MB,
+        len / MB
+    );
+    assert!(
+        msgs[0].contains("\"center\" takes at most 1024 numbers"),
+        "{msgs:?}"
+    );
 }
-
 
 #[test]
 fn a_file_of_newlines_with_an_error_costs_at_most_four_bytes_a_line() {
@@ -78,6 +90,14 @@ fn a_file_of_newlines_with_an_error_costs_at_most_four_bytes_a_line() {
         text.extend(b"}\n");
         text
     });
-    assert!(peak < 5 * len, "peak {} MB for {} MB of newlines", peak / MB, len / MB);
-    assert!(msgs[0].starts_with(&format!("hostile.txt:{}:1:", 16 * MB + 1)), "{msgs:?}");
+    assert!(
+        peak < 5 * len,
+        "peak {} MB for {} MB of newlines",
+        peak / MB,
+        len / MB
+    );
+    assert!(
+        msgs[0].starts_with(&format!("hostile.txt:{}:1:", 16 * MB + 1)),
+        "{msgs:?}"
+    );
 }

@@ -4,7 +4,9 @@
 
 use glam::{Mat4, Vec3};
 use tracelab_core::geometry::Ray;
-use tracelab_core::{Graph, Material, Node, NodeKind, NormalTransform, Scene, TransformOp, compile};
+use tracelab_core::{
+    Graph, Material, Node, NodeKind, NormalTransform, Scene, TransformOp, compile,
+};
 
 struct Rng(u64);
 impl Rng {
@@ -24,8 +26,14 @@ fn sphere_under(m: Mat4) -> Scene {
     let mut scene = Scene::default();
     scene.materials.push(Material::diffuse(Vec3::ONE));
     let mut g = Graph::new();
-    let t = g.add(Node { material: Some(0), ..Node::new(NodeKind::Transform(vec![TransformOp::Matrix(m)])) });
-    let s = g.add(Node::new(NodeKind::Sphere { center: Vec3::ZERO, radius: 1.0 }));
+    let t = g.add(Node {
+        material: Some(0),
+        ..Node::new(NodeKind::Transform(vec![TransformOp::Matrix(m)]))
+    });
+    let s = g.add(Node::new(NodeKind::Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+    }));
     g.push_child(g.root(), t);
     g.push_child(t, s);
     scene.graph = g;
@@ -46,7 +54,11 @@ fn sheared_sphere_normal_stays_perpendicular_to_surface() {
     let mut checked = 0;
     for _ in 0..200 {
         // Random affine map with shear and non-uniform scale, kept well conditioned.
-        let lin = glam::Mat3::from_cols(rng.v() * 0.6 + Vec3::X, rng.v() * 0.6 + Vec3::Y, rng.v() * 0.6 + Vec3::Z);
+        let lin = glam::Mat3::from_cols(
+            rng.v() * 0.6 + Vec3::X,
+            rng.v() * 0.6 + Vec3::Y,
+            rng.v() * 0.6 + Vec3::Z,
+        );
         if lin.determinant().abs() < 0.2 {
             continue;
         }
@@ -58,21 +70,33 @@ fn sheared_sphere_normal_stays_perpendicular_to_surface() {
             let target = m.transform_point3(p_obj);
             let origin = target + rng.v().normalize_or(Vec3::Z) * 10.0;
             let ray = Ray::new(origin, (target - origin).normalize());
-            let Some(hit) = compiled.intersect(&ray, 0.0, f32::INFINITY) else { continue };
+            let Some(hit) = compiled.intersect(&ray, 0.0, f32::INFINITY) else {
+                continue;
+            };
             let p_hit = m.inverse().transform_point3(ray.at(hit.t));
             let n = compiled.world_normal(&ray, &hit, NormalTransform::Correct);
             for tangent in world_tangents(&m, p_hit.normalize()) {
-                assert!(n.dot(tangent.normalize()).abs() < 2e-3, "correct normal not perpendicular: {}", n.dot(tangent.normalize()));
+                assert!(
+                    n.dot(tangent.normalize()).abs() < 2e-3,
+                    "correct normal not perpendicular: {}",
+                    n.dot(tangent.normalize())
+                );
             }
             let wrong = compiled.world_normal(&ray, &hit, NormalTransform::Incorrect);
-            if world_tangents(&m, p_hit.normalize()).iter().any(|t| wrong.dot(t.normalize()).abs() > 0.05) {
+            if world_tangents(&m, p_hit.normalize())
+                .iter()
+                .any(|t| wrong.dot(t.normalize()).abs() > 0.05)
+            {
                 incorrect_off += 1;
             }
             checked += 1;
         }
     }
     assert!(checked > 500, "too few hits checked: {checked}");
-    assert!(incorrect_off > checked / 2, "M·n should usually be off the perpendicular: {incorrect_off}/{checked}");
+    assert!(
+        incorrect_off > checked / 2,
+        "M·n should usually be off the perpendicular: {incorrect_off}/{checked}"
+    );
 }
 
 #[test]
@@ -87,7 +111,9 @@ fn incorrect_mode_equals_correct_for_similitudes() {
         let target = m.transform_point3(rng.v().normalize_or(Vec3::X));
         let origin = target + rng.v().normalize_or(Vec3::Z) * 20.0;
         let ray = Ray::new(origin, (target - origin).normalize());
-        let Some(hit) = compiled.intersect(&ray, 0.0, f32::INFINITY) else { continue };
+        let Some(hit) = compiled.intersect(&ray, 0.0, f32::INFINITY) else {
+            continue;
+        };
         let a = compiled.world_normal(&ray, &hit, NormalTransform::Correct);
         let b = compiled.world_normal(&ray, &hit, NormalTransform::Incorrect);
         assert!((a - b).length() < 1e-4, "{a} vs {b}");

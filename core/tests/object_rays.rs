@@ -16,7 +16,11 @@ fn repo() -> PathBuf {
 
 fn shared() -> PathBuf {
     let p = repo().join("../shared/mit6837");
-    assert!(p.join("scenes").is_dir(), "{} is missing: this test needs ../shared beside the checkout", p.display());
+    assert!(
+        p.join("scenes").is_dir(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        p.display()
+    );
     p
 }
 
@@ -28,7 +32,13 @@ fn load(path: &Path) -> Scene {
 }
 
 fn render(scene: &Scene, w: u32, h: u32, object_rays: ObjectRays) -> Frame {
-    render_frame(&compile(scene), &RenderSettings { object_rays, ..RenderSettings::new(w, h) })
+    render_frame(
+        &compile(scene),
+        &RenderSettings {
+            object_rays,
+            ..RenderSettings::new(w, h)
+        },
+    )
 }
 
 /// The screen point of pixel (x, row) of a w×h orthographic image of size `size` centred on
@@ -56,17 +66,41 @@ fn assert_same_to_rounding(a: &Frame, b: &Frame, what: &str) {
             off += 1;
             continue;
         }
-        let dc = p.color.iter().zip(&q.color).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+        let dc = p
+            .color
+            .iter()
+            .zip(&q.color)
+            .map(|(x, y)| x.abs_diff(*y))
+            .max()
+            .unwrap_or(0);
         assert!(dc <= 1, "{what}: colour {:?} vs {:?}", p.color, q.color);
         if p.is_hit() {
-            assert!((p.t - q.t).abs() <= 1e-5 * p.t.abs().max(1.0), "{what}: t {} vs {}", p.t, q.t);
+            assert!(
+                (p.t - q.t).abs() <= 1e-5 * p.t.abs().max(1.0),
+                "{what}: t {} vs {}",
+                p.t,
+                q.t
+            );
         }
     }
     let allowed = a.samples.len() / 500;
-    assert!(off <= allowed, "{what}: {off} pixels hit a different node (allowed {allowed})");
-    let (da, db) = (a.rgb8(View::Depth, (2.0, 7.0)), b.rgb8(View::Depth, (2.0, 7.0)));
-    let depth_off = da.iter().zip(&db).filter(|(x, y)| x.abs_diff(**y) > 1).count();
-    assert!(depth_off <= allowed * 3, "{what}: depth images differ on {depth_off} channels");
+    assert!(
+        off <= allowed,
+        "{what}: {off} pixels hit a different node (allowed {allowed})"
+    );
+    let (da, db) = (
+        a.rgb8(View::Depth, (2.0, 7.0)),
+        b.rgb8(View::Depth, (2.0, 7.0)),
+    );
+    let depth_off = da
+        .iter()
+        .zip(&db)
+        .filter(|(x, y)| x.abs_diff(**y) > 1)
+        .count();
+    assert!(
+        depth_off <= allowed * 3,
+        "{what}: depth images differ on {depth_off} channels"
+    );
 }
 
 const DEPTH_T: &str = "scenes/lecture/depth_t.txt";
@@ -95,7 +129,11 @@ fn forgetting_to_rescale_t_puts_the_big_sphere_in_front_of_the_small_one() {
             let (sx, sy) = screen(x, row, w, h, 6.0);
             let red = sphere_t(sx, sy, 10.0, [0.6, 0.0, 0.0], 1.0);
             let blue = sphere_t(sx, sy, 10.0, [-0.6, 0.0, -4.0], 2.0);
-            if [red, blue].iter().flatten().any(|&(_, inside)| inside < 1e-3) {
+            if [red, blue]
+                .iter()
+                .flatten()
+                .any(|&(_, inside)| inside < 1e-3)
+            {
                 continue; // grazing a silhouette
             }
             // (t kept, is red) under each rule.
@@ -113,8 +151,17 @@ fn forgetting_to_rescale_t_puts_the_big_sphere_in_front_of_the_small_one() {
                     None => assert!(!p.is_hit(), "{x},{row} should miss"),
                     Some((t, is_red)) => {
                         assert!(p.is_hit(), "{x},{row} should hit");
-                        assert!((p.t - t).abs() < 1e-4 * t, "{x},{row}: t {} expected {t}", p.t);
-                        assert_eq!(p.color[0] > p.color[2], is_red, "{x},{row}: colour {:?}", p.color);
+                        assert!(
+                            (p.t - t).abs() < 1e-4 * t,
+                            "{x},{row}: t {} expected {t}",
+                            p.t
+                        );
+                        assert_eq!(
+                            p.color[0] > p.color[2],
+                            is_red,
+                            "{x},{row}: colour {:?}",
+                            p.color
+                        );
                         checked += 1;
                     }
                 }
@@ -141,9 +188,16 @@ fn the_inspector_reports_t_in_both_spaces_and_the_one_kept() {
     for (rule, t_object, t_used) in [
         (ObjectRays::Unnormalized, t_world, t_world),
         (ObjectRays::Normalized, 2.0 * t_world, t_world),
-        (ObjectRays::NormalizedNoRescale, 2.0 * t_world, 2.0 * t_world),
+        (
+            ObjectRays::NormalizedNoRescale,
+            2.0 * t_world,
+            2.0 * t_world,
+        ),
     ] {
-        let settings = RenderSettings { object_rays: rule, ..RenderSettings::new(w, h) };
+        let settings = RenderSettings {
+            object_rays: rule,
+            ..RenderSettings::new(w, h)
+        };
         let story = inspect_pixel(&s, &c, &settings, x, row);
         let hit = story.hit.expect("hit");
         if rule == ObjectRays::NormalizedNoRescale {
@@ -151,18 +205,38 @@ fn the_inspector_reports_t_in_both_spaces_and_the_one_kept() {
             assert!(hit.shade.diffuse.z > hit.shade.diffuse.x, "{rule:?}");
             let (tb, _) = sphere_t(sx, sy, 10.0, [-0.6, 0.0, -4.0], 2.0).expect("on blue");
             assert!((hit.t - tb).abs() < 1e-4 * tb, "{} vs {tb}", hit.t);
-            assert!((hit.t_object - tb / 4.0).abs() < 1e-4 * tb, "{}", hit.t_object);
+            assert!(
+                (hit.t_object - tb / 4.0).abs() < 1e-4 * tb,
+                "{}",
+                hit.t_object
+            );
             assert!((hit.t_used - tb / 4.0).abs() < 1e-4 * tb);
             continue;
         }
         assert_eq!(hit.object_rays, rule);
-        assert!((hit.t - t_world).abs() < 1e-4 * t_world, "{rule:?}: {}", hit.t);
-        assert!((hit.t_object - t_object).abs() < 1e-4 * t_object, "{rule:?}: {}", hit.t_object);
-        assert!((hit.t_used - t_used).abs() < 1e-4 * t_used, "{rule:?}: {}", hit.t_used);
+        assert!(
+            (hit.t - t_world).abs() < 1e-4 * t_world,
+            "{rule:?}: {}",
+            hit.t
+        );
+        assert!(
+            (hit.t_object - t_object).abs() < 1e-4 * t_object,
+            "{rule:?}: {}",
+            hit.t_object
+        );
+        assert!(
+            (hit.t_used - t_used).abs() < 1e-4 * t_used,
+            "{rule:?}: {}",
+            hit.t_used
+        );
         // The traced ray lands on the same object point at its own t.
         assert!((hit.traced_ray.at(hit.t_object) - hit.object_point).length() < 1e-3);
         let unit = rule != ObjectRays::Unnormalized;
-        assert_eq!((hit.traced_ray.direction.length() - 1.0).abs() < 1e-5, unit, "{rule:?}");
+        assert_eq!(
+            (hit.traced_ray.direction.length() - 1.0).abs() < 1e-5,
+            unit,
+            "{rule:?}"
+        );
     }
 }
 
@@ -209,11 +283,31 @@ fn t_scale_without_rescaling_has_scaled_depths_and_yellow_falls_behind_green() {
     let (sx, sy) = screen(100, 100, w, h, 5.5);
     let (ty, _) = sphere_t(sx, sy, 5.0, [0.0, 0.0, 1.6], 0.5).expect("yellow");
     let (tg, _) = sphere_t(sx, sy, 5.0, [0.0, 0.0, 0.0], 1.0).expect("green");
-    assert!((c.t - ty).abs() < 1e-4 && (cb.t - tg).abs() < 1e-4, "{} {ty} / {} {tg}", c.t, cb.t);
-    assert!(c.color[0] > 100 && c.color[1] > 100 && c.color[2] < 50, "yellow {:?}", c.color);
-    assert!(cb.color[0] < 50 && cb.color[1] > 100 && cb.color[2] < 50, "green {:?}", cb.color);
+    assert!(
+        (c.t - ty).abs() < 1e-4 && (cb.t - tg).abs() < 1e-4,
+        "{} {ty} / {} {tg}",
+        c.t,
+        cb.t
+    );
+    assert!(
+        c.color[0] > 100 && c.color[1] > 100 && c.color[2] < 50,
+        "yellow {:?}",
+        c.color
+    );
+    assert!(
+        cb.color[0] < 50 && cb.color[1] > 100 && cb.color[2] < 50,
+        "green {:?}",
+        cb.color
+    );
     // And the depth image shows it: many pixels change by more than rounding.
-    let (dg, db) = (good.rgb8(View::Depth, (2.0, 7.0)), bug.rgb8(View::Depth, (2.0, 7.0)));
-    let changed = dg.chunks(3).zip(db.chunks(3)).filter(|(a, b)| a[0].abs_diff(b[0]) > 8).count();
+    let (dg, db) = (
+        good.rgb8(View::Depth, (2.0, 7.0)),
+        bug.rgb8(View::Depth, (2.0, 7.0)),
+    );
+    let changed = dg
+        .chunks(3)
+        .zip(db.chunks(3))
+        .filter(|(a, b)| a[0].abs_diff(b[0]) > 8)
+        .count();
     assert!(changed > 5000, "only {changed} depth pixels change");
 }

@@ -102,9 +102,19 @@ fn many_instances_share_one_walk_of_the_top_level_bvh() {
             1 => "Sphere { center 0 0 0 radius 1 }".to_string(),
             _ => "Box { min -1 -1 -1 max 1 1 1 }".to_string(),
         };
-        let (sx, sy) = (0.15 + r() * 0.3, if i % 2 == 0 { 0.15 + r() * 0.3 } else { 0.0 });
-        let scale = if sy > 0.0 { format!("Scale {sx} {sy} {sx}") } else { format!("UniformScale {sx}") };
-        objs += &format!("Transform {{ Translate {x} {y} {z} YRotate {} {scale} {shape} }} ", r() * 360.0);
+        let (sx, sy) = (
+            0.15 + r() * 0.3,
+            if i % 2 == 0 { 0.15 + r() * 0.3 } else { 0.0 },
+        );
+        let scale = if sy > 0.0 {
+            format!("Scale {sx} {sy} {sx}")
+        } else {
+            format!("UniformScale {sx}")
+        };
+        objs += &format!(
+            "Transform {{ Translate {x} {y} {z} YRotate {} {scale} {shape} }} ",
+            r() * 360.0
+        );
     }
     let c = compiled(&objs, n);
     let hits = assert_tiles_agree(&c, 48, 40);
@@ -121,7 +131,8 @@ fn exact_ties_go_to_the_first_object_in_file_order() {
     let b = "Box { min -0.5 -1.5 -3 max 1.5 0.5 1 }";
     let plane = "Plane { normal 0 0 1 offset 1 }";
     let sphere = "Sphere { center 0.3 0 0 radius 1 }";
-    let mesh = "Transform { YRotate 20 Scale 1 0.6 1 TriangleMesh { obj_file ../assets/icosphere.obj } }";
+    let mesh =
+        "Transform { YRotate 20 Scale 1 0.6 1 TriangleMesh { obj_file ../assets/icosphere.obj } }";
     for objs in [
         vec![a, b],
         vec![b, a],
@@ -140,16 +151,21 @@ fn exact_ties_go_to_the_first_object_in_file_order() {
                 // The course's loop: objects in file order, a hit kept only if strictly nearer.
                 let mut want: Option<(f32, u32)> = None;
                 for i in 0..objs.len() as u32 {
-                    if let Some((t, _)) = c.intersect_object(i, &ray, t_min, want.map_or(f32::INFINITY, |w| w.0)) {
+                    if let Some((t, _)) =
+                        c.intersect_object(i, &ray, t_min, want.map_or(f32::INFINITY, |w| w.0))
+                    {
                         want = Some((t, i));
                     }
                 }
-                let got = c.intersect(&ray, t_min, f32::INFINITY).map(|h| (h.t, h.object));
+                let got = c
+                    .intersect(&ray, t_min, f32::INFINITY)
+                    .map(|h| (h.t, h.object));
                 assert_eq!(got, want, "{objs:?}: pixel ({x}, {y})");
                 if let Some((t, i)) = want {
-                    ties += (i + 1..objs.len() as u32)
-                        .any(|j| c.intersect_object(j, &ray, t_min, t.next_up()).is_some_and(|h| h.0 == t))
-                        as u32;
+                    ties += (i + 1..objs.len() as u32).any(|j| {
+                        c.intersect_object(j, &ray, t_min, t.next_up())
+                            .is_some_and(|h| h.0 == t)
+                    }) as u32;
                 }
             }
         }

@@ -10,15 +10,25 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
-use tracelab_core::{CompiledScene, Frame, MeshCache, NormalTransform, RenderSettings, SharedFrame, load_scene};
+use tracelab_core::{
+    CompiledScene, Frame, MeshCache, NormalTransform, RenderSettings, SharedFrame, load_scene,
+};
 
 fn same(a: &Frame, b: &Frame) -> Result<(), String> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err("sizes differ".into());
     }
     for (i, (x, y)) in a.samples.iter().zip(&b.samples).enumerate() {
-        if x.color != y.color || x.normal != y.normal || x.t.to_bits() != y.t.to_bits() || x.node != y.node {
-            return Err(format!("pixel {} of row {} differs: {x:?} vs {y:?}", i as u32 % a.width, i as u32 / a.width));
+        if x.color != y.color
+            || x.normal != y.normal
+            || x.t.to_bits() != y.t.to_bits()
+            || x.node != y.node
+        {
+            return Err(format!(
+                "pixel {} of row {} differs: {x:?} vs {y:?}",
+                i as u32 % a.width,
+                i as u32 / a.width
+            ));
         }
     }
     Ok(())
@@ -32,24 +42,39 @@ fn check(path: &Path, (w, h): (u32, u32)) {
     let c = CompiledScene::new(&scene);
     for normal_transform in [NormalTransform::Correct, NormalTransform::Incorrect] {
         for shade_back in [false, true] {
-            let s = RenderSettings { shade_back, normal_transform, ..RenderSettings::new(w, h) };
+            let s = RenderSettings {
+                shade_back,
+                normal_transform,
+                ..RenderSettings::new(w, h)
+            };
             let single = render_frame_traced(&c, &s, Tracing::SingleRays);
             let packets = render_frame_traced(&c, &s, Tracing::Packets);
-            same(&single, &packets).unwrap_or_else(|e| panic!("{} {s:?}: one pass: {e}", path.display()));
+            same(&single, &packets)
+                .unwrap_or_else(|e| panic!("{} {s:?}: one pass: {e}", path.display()));
             let target = SharedFrame::new();
             let never = std::sync::atomic::AtomicBool::new(false);
-            render_progressive_traced(&c, &s, &target, &never, Tracing::Packets, |_| {}).expect("not cancelled");
-            same(&single, &target.lock()).unwrap_or_else(|e| panic!("{} {s:?}: progressive: {e}", path.display()));
+            render_progressive_traced(&c, &s, &target, &never, Tracing::Packets, |_| {})
+                .expect("not cancelled");
+            same(&single, &target.lock())
+                .unwrap_or_else(|e| panic!("{} {s:?}: progressive: {e}", path.display()));
         }
     }
 }
 
 fn txt_files(dir: &Path, prefix: &str) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}: this test needs ../shared beside the checkout", dir.display()))
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}: this test needs ../shared beside the checkout",
+                dir.display()
+            )
+        })
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "txt"))
-        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with(prefix)))
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with(prefix))
+        })
         .collect();
     v.sort();
     v
@@ -64,7 +89,11 @@ fn the_kernels_are_the_ones_tracelab_simd_asks_for() {
         Ok("avx") => Level::Avx.min(detected()),
         _ => detected(),
     };
-    eprintln!("kernels in use: {} (the CPU has {})", level().name(), detected().name());
+    eprintln!(
+        "kernels in use: {} (the CPU has {})",
+        level().name(),
+        detected().name()
+    );
     assert_eq!(level(), want);
 }
 
@@ -94,5 +123,8 @@ fn packets_match_single_rays_on_the_course_and_perf_scenes() {
         check(s, (64, 48));
     }
     // 1,000 instances of the course's bunny_1k: the top-level BVH walked by packets.
-    check(&common::repo().join("scenes/perf/bunny_instances_1000.txt"), (64, 48));
+    check(
+        &common::repo().join("scenes/perf/bunny_instances_1000.txt"),
+        (64, 48),
+    );
 }

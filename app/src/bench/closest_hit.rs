@@ -147,9 +147,7 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
         (w as f64 * h as f64) / best / 1e6
     );
     let mode = if b.packets { " mode=packets" } else { "" };
-    out!(
-        "BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}"
-    );
+    out!("BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}");
     Ok(())
 }
 
@@ -168,4 +166,3 @@ fn distinct_meshes(scene: &Scene) -> Vec<Arc<Mesh>> {
     }
     meshes
 }
-

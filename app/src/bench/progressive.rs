@@ -4,8 +4,8 @@
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::SharedFrame;
 use glam::Vec3;
+use tracelab_core::render::SharedFrame;
 use tracelab_core::render::render_coarse;
 use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
 use tracelab_core::{CompiledScene, RenderSettings, Scene, render_progressive};
@@ -26,7 +26,11 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let settings = RenderSettings::new(w, h);
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
-    let tracing = if b.single_rays { Tracing::SingleRays } else { Tracing::Packets };
+    let tracing = if b.single_rays {
+        Tracing::SingleRays
+    } else {
+        Tracing::Packets
+    };
     // (first coarse image, full frame, each pass's scale and own time), in ms.
     let once = || {
         let start = Instant::now();
@@ -40,9 +44,16 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |p| {
             ends.push((p.scale, start.elapsed().as_secs_f64() * 1e3));
         });
-        let full = ends.last().map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |e| e.1);
+        let full = ends
+            .last()
+            .map_or_else(|| start.elapsed().as_secs_f64() * 1e3, |e| e.1);
         // The first pass's time counts from the compile, as the coarse image's does.
-        let passes = ends.iter().scan(0.0, |before, &(s, end)| Some((s, end - std::mem::replace(before, end)))).collect();
+        let passes = ends
+            .iter()
+            .scan(0.0, |before, &(s, end)| {
+                Some((s, end - std::mem::replace(before, end)))
+            })
+            .collect();
         (ends.first().map_or(full, |e| e.1), full, passes)
     };
     once(); // warm-up
@@ -57,8 +68,15 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let passes: Vec<String> = scales
         .iter()
         .map(|&s| {
-            let times: Vec<f64> = runs.iter().flat_map(|r| r.2.iter().filter(|p| p.0 == s).map(|p| p.1)).collect();
-            let some = if times.len() < runs.len() { format!(" (in {} of {} runs)", times.len(), runs.len()) } else { String::new() };
+            let times: Vec<f64> = runs
+                .iter()
+                .flat_map(|r| r.2.iter().filter(|p| p.0 == s).map(|p| p.1))
+                .collect();
+            let some = if times.len() < runs.len() {
+                format!(" (in {} of {} runs)", times.len(), runs.len())
+            } else {
+                String::new()
+            };
             format!("{s}× {:.2}{some}", median(times))
         })
         .collect();
@@ -67,10 +85,21 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         rayon::current_num_threads(),
         tracelab_core::simd::level().name(),
         runs.len(),
-        if b.one_pass { "one full-resolution pass" } else { "coarse passes, then the full one" },
-        if b.single_rays { "one at a time" } else { "in packets of 8" }
+        if b.one_pass {
+            "one full-resolution pass"
+        } else {
+            "coarse passes, then the full one"
+        },
+        if b.single_rays {
+            "one at a time"
+        } else {
+            "in packets of 8"
+        }
     );
-    out!("passes: {} ms each (scale, median; the first from the compile on)", passes.join(" + "));
+    out!(
+        "passes: {} ms each (scale, median; the first from the compile on)",
+        passes.join(" + ")
+    );
     out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
     if let Some(steps) = b.orbit {
         run_orbit(&scene, &settings, steps.max(1))?;
@@ -109,7 +138,9 @@ fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::
         let start = Instant::now();
         let compiled = CompiledScene::new(&step_scene(k));
         let mut t_full = Duration::ZERO;
-        let _ = render_progressive(&compiled, settings, &target, &never, |_| t_full = start.elapsed());
+        let _ = render_progressive(&compiled, settings, &target, &never, |_| {
+            t_full = start.elapsed()
+        });
         full.push(t_full.as_secs_f64() * 1e3);
     }
     out!(

@@ -49,7 +49,9 @@ pub struct AnimateArgs {
 }
 
 pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
-    let &[w, h] = a.size.as_slice() else { return Err(usage("--size needs W H")) };
+    let &[w, h] = a.size.as_slice() else {
+        return Err(usage("--size needs W H"));
+    };
     check_size(w, h)?;
     if a.frames == 0 || a.frames > 10_000 {
         return Err(usage(format!("--frames {}: expected 1 to 10000", a.frames)));
@@ -58,7 +60,14 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
         return Err(usage("--from and --to must be finite numbers"));
     }
     let scene = load_scene(Some(&a.scene))?;
-    let sweep = Sweep { node: NodeId(a.node), op: a.op, component: a.component, from: a.from, to: a.to, frames: a.frames };
+    let sweep = Sweep {
+        node: NodeId(a.node),
+        op: a.op,
+        component: a.component,
+        from: a.from,
+        to: a.to,
+        frames: a.frames,
+    };
     let settings = RenderSettings {
         normal_transform: a.normal_transform.into(),
         object_rays: a.object_rays.into(),

@@ -26,7 +26,9 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     };
     let mut it = args.iter();
     let take = |it: &mut std::slice::Iter<OsString>, flag: &str| -> anyhow::Result<OsString> {
-        it.next().cloned().ok_or_else(|| usage(format!("{flag} needs a value")))
+        it.next()
+            .cloned()
+            .ok_or_else(|| usage(format!("{flag} needs a value")))
     };
     while let Some(arg) = it.next() {
         // Flags are ASCII; a value after one may be any bytes (a file name).
@@ -50,7 +52,12 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
                 job.normal_transform = match v.to_str() {
                     Some("correct") => NormalTransform::Correct,
                     Some("incorrect") => NormalTransform::Incorrect,
-                    _ => return Err(usage(format!("-normal_transform: expected correct or incorrect, found \"{}\"", v.display()))),
+                    _ => {
+                        return Err(usage(format!(
+                            "-normal_transform: expected correct or incorrect, found \"{}\"",
+                            v.display()
+                        )));
+                    }
                 }
             }
             "-object_rays" => {
@@ -62,7 +69,12 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
                     ))
                 })?;
             }
-            _ => return Err(usage(format!("unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back)", arg.display()))),
+            _ => {
+                return Err(usage(format!(
+                    "unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back)",
+                    arg.display()
+                )));
+            }
         }
     }
     if job.scene.is_none() {

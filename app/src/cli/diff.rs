@@ -48,7 +48,12 @@ pub struct DiffArgs {
     #[arg(long, default_value_t = 5)]
     pub worst: usize,
     /// The course's command line, after `--`: -input F -size W H -output F [-normals F] [-depth MIN MAX F] ...
-    #[arg(last = true, required = true, allow_hyphen_values = true, value_name = "COURSE-COMMAND-LINE")]
+    #[arg(
+        last = true,
+        required = true,
+        allow_hyphen_values = true,
+        value_name = "COURSE-COMMAND-LINE"
+    )]
     pub course: Vec<OsString>,
 }
 
@@ -64,12 +69,21 @@ pub struct Comparison {
 
 impl Comparison {
     pub fn percent(&self) -> f64 {
-        if self.total == 0 { 100.0 } else { 100.0 * self.within as f64 / self.total as f64 }
+        if self.total == 0 {
+            100.0
+        } else {
+            100.0 * self.within as f64 / self.total as f64
+        }
     }
 }
 
 /// Per-pixel comparison of two images of the same size.
-pub fn compare(mine: &RgbImage, reference: &RgbImage, tolerance: u8, keep_worst: usize) -> Comparison {
+pub fn compare(
+    mine: &RgbImage,
+    reference: &RgbImage,
+    tolerance: u8,
+    keep_worst: usize,
+) -> Comparison {
     let mut within = 0;
     let mut max_difference = 0;
     let mut off = Vec::new();
@@ -85,7 +99,12 @@ pub fn compare(mine: &RgbImage, reference: &RgbImage, tolerance: u8, keep_worst:
     }
     off.sort_by(|a, b| b.0.cmp(&a.0).then((a.2, a.1).cmp(&(b.2, b.1))));
     off.truncate(keep_worst);
-    Comparison { within, total: (mine.width() * mine.height()) as usize, max_difference, worst: off }
+    Comparison {
+        within,
+        total: (mine.width() * mine.height()) as usize,
+        max_difference,
+        worst: off,
+    }
 }
 
 /// The heat map: matching pixels as the reference dimmed to a quarter in grey, the others
@@ -117,7 +136,10 @@ fn read_image(path: &Path) -> anyhow::Result<RgbImage> {
 
 /// `mine.png` → `mine.diff.png`, beside it.
 fn heat_map_path(image: &Path) -> PathBuf {
-    let stem = image.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "image".into());
+    let stem = image
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
     image.with_file_name(format!("{stem}.diff.png"))
 }
 
@@ -125,7 +147,8 @@ fn write_png(img: &RgbImage, path: &Path) -> anyhow::Result<()> {
     let mut bytes = Vec::new();
     img.write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| anyhow::anyhow!("{}: cannot encode heat map: {e}", path.display()))?;
-    write_atomic(path, &bytes).map_err(|e| anyhow::anyhow!("{}: cannot write heat map: {e}", path.display()))
+    write_atomic(path, &bytes)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write heat map: {e}", path.display()))
 }
 
 struct Reference<'a> {
@@ -137,7 +160,15 @@ struct Reference<'a> {
 
 /// Compares one of the student's images with one view of the reference, printing the
 /// verdict and the worst pixels. Returns whether it matches.
-fn check(a: &DiffArgs, r: &Reference, what: &str, mine_path: &Path, view: View, depth: (f32, f32), out: &mut String) -> anyhow::Result<bool> {
+fn check(
+    a: &DiffArgs,
+    r: &Reference,
+    what: &str,
+    mine_path: &Path,
+    view: View,
+    depth: (f32, f32),
+    out: &mut String,
+) -> anyhow::Result<bool> {
     let mine = read_image(mine_path)?;
     let (w, h) = (r.frame.width, r.frame.height);
     if mine.dimensions() != (w, h) {
@@ -180,7 +211,10 @@ fn check(a: &DiffArgs, r: &Reference, what: &str, mine_path: &Path, view: View, 
 
 pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     if !(0.0..=100.0).contains(&a.min_match) {
-        return Err(usage(format!("--min-match {}: expected a percentage from 0 to 100", a.min_match)));
+        return Err(usage(format!(
+            "--min-match {}: expected a percentage from 0 to 100",
+            a.min_match
+        )));
     }
     let job: RenderJob = parse_course_args(&a.course)?;
     check_size(job.width, job.height)?;
@@ -193,7 +227,12 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         ..RenderSettings::new(job.width, job.height)
     };
     let frame = render_with_progress(&compiled, &settings);
-    let r = Reference { scene: &scene, compiled: &compiled, settings, frame: &frame };
+    let r = Reference {
+        scene: &scene,
+        compiled: &compiled,
+        settings,
+        frame: &frame,
+    };
     let mut out = String::new();
     let mut all = check(a, &r, "colour", &a.image, View::Color, (0.0, 1.0), &mut out)?;
     if let Some(n) = &job.normals {
@@ -203,7 +242,11 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         all &= check(a, &r, "depth", d, View::Depth, (*min, *max), &mut out)?;
     }
     write_stdout(out.as_bytes())?;
-    if all { Ok(()) } else { Err(Exit::Differs.into()) }
+    if all {
+        Ok(())
+    } else {
+        Err(Exit::Differs.into())
+    }
 }
 
 #[cfg(test)]

@@ -9,7 +9,10 @@ use crate::io::{load_scene_text, write_stdout};
 pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()> {
     let mut s = load_scene_text(scene)?;
     if let Some(out) = output {
-        let dir = |p: &Path| p.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+        let dir = |p: &Path| {
+            p.parent()
+                .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+        };
         for w in tracelab_core::rebase_mesh_paths(&mut s, &dir(scene), &dir(out)) {
             eprintln!("{}: warning: {w}", out.display());
         }
@@ -21,4 +24,3 @@ pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()>
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", out.display())),
     }
 }
-

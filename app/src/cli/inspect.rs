@@ -66,7 +66,9 @@ pub fn run_inspect(a: &InspectArgs) -> anyhow::Result<()> {
     let story = inspect_pixel(&scene, &compiled, &settings, x, row);
     let report = pixel_report(&scene, &story, &settings);
     let text = if a.json {
-        serde_json::to_string_pretty(&report).map_err(|e| anyhow::anyhow!("cannot write JSON: {e}"))? + "\n"
+        serde_json::to_string_pretty(&report)
+            .map_err(|e| anyhow::anyhow!("cannot write JSON: {e}"))?
+            + "\n"
     } else {
         report_text(&report)
     };

@@ -106,7 +106,12 @@ fn print_err(text: &str) {
 pub fn run(args: &[OsString]) -> anyhow::Result<()> {
     // The course's raytracer flags start with a single dash: `-input`, `-size`, ... A course
     // line after `--` belongs to a subcommand (`tracelab diff mine.png -- -input ...`).
-    if args.iter().skip(1).take_while(|a| *a != "--").any(|a| a == "-input") {
+    if args
+        .iter()
+        .skip(1)
+        .take_while(|a| *a != "--")
+        .any(|a| a == "-input")
+    {
         let job = parse_course_args(args.get(1..).unwrap_or_default())?;
         return run_render(&job);
     }
@@ -116,7 +121,9 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
             // --help and --version print and succeed; real usage errors exit 2.
             let _ = e.print();
             return match e.kind() {
-                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => Ok(()),
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
+                    Ok(())
+                }
                 _ => Err(Exit::UsagePrinted.into()),
             };
         }
@@ -129,13 +136,18 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
         Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
         Some(Command::BenchProgressive(b)) => {
-            with_threads(b.threads.unwrap_or_else(rayon::current_num_threads), || crate::bench::run_progressive(&b))
+            with_threads(b.threads.unwrap_or_else(rayon::current_num_threads), || {
+                crate::bench::run_progressive(&b)
+            })
         }
         None => crate::gui::run(cli.scene),
     }
 }
 
-fn with_threads(threads: usize, f: impl FnOnce() -> anyhow::Result<()> + Send) -> anyhow::Result<()> {
+fn with_threads(
+    threads: usize,
+    f: impl FnOnce() -> anyhow::Result<()> + Send,
+) -> anyhow::Result<()> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
         .build()

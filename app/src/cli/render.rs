@@ -101,7 +101,11 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
             let [min, max, file] = v.as_slice() else {
                 return Err(usage("--depth needs MIN MAX FILE"));
             };
-            Some((parse_f32(min, "--depth MIN")?, parse_f32(max, "--depth MAX")?, PathBuf::from(file)))
+            Some((
+                parse_f32(min, "--depth MIN")?,
+                parse_f32(max, "--depth MAX")?,
+                PathBuf::from(file),
+            ))
         }
     };
     let job = RenderJob {
@@ -116,7 +120,9 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
         object_rays: r.object_rays.into(),
     };
     if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
-        return Err(usage("nothing to write: give --output, --normals or --depth"));
+        return Err(usage(
+            "nothing to write: give --output, --normals or --depth",
+        ));
     }
     Ok(job)
 }
@@ -132,7 +138,11 @@ fn check_extension(path: &Path) -> anyhow::Result<()> {
 }
 
 pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
-    for p in [&job.output, &job.normals].into_iter().flatten().chain(job.depth.as_ref().map(|d| &d.2)) {
+    for p in [&job.output, &job.normals]
+        .into_iter()
+        .flatten()
+        .chain(job.depth.as_ref().map(|d| &d.2))
+    {
         check_extension(p)?;
     }
     // Before loading, and long before allocating the frame.
@@ -163,7 +173,10 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
 }
 
 /// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
-pub(super) fn render_with_progress(scene: &CompiledScene, settings: &RenderSettings) -> tracelab_core::Frame {
+pub(super) fn render_with_progress(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+) -> tracelab_core::Frame {
     let target = Arc::new(SharedFrame::new());
     let done = Arc::new(AtomicBool::new(false));
     let watcher = std::io::stderr().is_terminal().then(|| {
@@ -176,7 +189,12 @@ pub(super) fn render_with_progress(scene: &CompiledScene, settings: &RenderSetti
                 if start.elapsed() > Duration::from_secs(1) {
                     let p = target.progress();
                     let bar = (p * 30.0) as usize;
-                    eprint!("\rrendering [{}{}] {:3.0}%", "#".repeat(bar), " ".repeat(30 - bar.min(30)), p * 100.0);
+                    eprint!(
+                        "\rrendering [{}{}] {:3.0}%",
+                        "#".repeat(bar),
+                        " ".repeat(30 - bar.min(30)),
+                        p * 100.0
+                    );
                     shown = true;
                 }
             }
@@ -193,4 +211,3 @@ pub(super) fn render_with_progress(scene: &CompiledScene, settings: &RenderSetti
     }
     std::mem::replace(&mut *target.lock(), tracelab_core::Frame::new(0, 0))
 }
-

@@ -8,13 +8,22 @@ pub(super) fn parse_f32(s: &OsStr, what: &str) -> anyhow::Result<f32> {
     s.to_str()
         .and_then(|t| t.parse::<f32>().ok())
         .filter(|v| v.is_finite())
-        .ok_or_else(|| usage(format!("{what}: expected a number, found \"{}\"", s.display())))
+        .ok_or_else(|| {
+            usage(format!(
+                "{what}: expected a number, found \"{}\"",
+                s.display()
+            ))
+        })
 }
 
 pub(super) fn parse_u32(s: &OsStr, what: &str) -> anyhow::Result<u32> {
     s.to_str()
         .and_then(|t| t.parse::<u32>().ok())
         .filter(|&v| v > 0)
-        .ok_or_else(|| usage(format!("{what}: expected a positive whole number, found \"{}\"", s.display())))
+        .ok_or_else(|| {
+            usage(format!(
+                "{what}: expected a positive whole number, found \"{}\"",
+                s.display()
+            ))
+        })
 }
-

@@ -2,11 +2,11 @@
 //! that carries them out (through [`apply_to`]) and records undo.
 
 use super::error::Misfit;
-use glam::Vec3;
 use super::op_target::{OpKind, op_target};
+use glam::Vec3;
 use tracelab_core::{
-    Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene, TransformOp,
-    check_scene,
+    Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene,
+    TransformOp, check_scene,
 };
 
 #[derive(Clone, Debug, PartialEq)]
@@ -119,7 +119,9 @@ impl Edit {
             Edit::SetCamera(_) => Some(CoalesceKey::Camera),
             Edit::SetLight { index, .. } => Some(CoalesceKey::Light(*index)),
             Edit::SetBackground(_) => Some(CoalesceKey::Background),
-            Edit::SetOpOfKind { node, op } => OpKind::of(op).map(|k| CoalesceKey::OpOfKind(*node, k)),
+            Edit::SetOpOfKind { node, op } => {
+                OpKind::of(op).map(|k| CoalesceKey::OpOfKind(*node, k))
+            }
             _ => None,
         }
     }
@@ -141,11 +143,21 @@ pub struct Refusal {
 
 impl Refusal {
     fn structural(reason: String) -> Self {
-        Refusal { place: None, field: String::new(), op: None, reason }
+        Refusal {
+            place: None,
+            field: String::new(),
+            op: None,
+            reason,
+        }
     }
 
     fn broken(p: &Problem) -> Self {
-        Refusal { place: Some(p.place), field: p.field.clone(), op: p.op, reason: p.reason.clone() }
+        Refusal {
+            place: Some(p.place),
+            field: p.field.clone(),
+            op: p.op,
+            reason: p.reason.clone(),
+        }
     }
 }
 
@@ -160,11 +172,18 @@ impl std::fmt::Display for Refusal {
 /// and `scene` stays as it was. Leaving a node incomplete (a new TriangleMesh with no file
 /// yet) is allowed; those problems come back with the new scene. `known` are the problems
 /// `scene` already has, which an edit does not answer for.
-pub fn apply_checked(scene: &Scene, known: &[Problem], edit: Edit) -> Result<(Scene, After, Vec<Problem>), Refusal> {
+pub fn apply_checked(
+    scene: &Scene,
+    known: &[Problem],
+    edit: Edit,
+) -> Result<(Scene, After, Vec<Problem>), Refusal> {
     let mut next = scene.clone();
     let after = apply_to(&mut next, edit).map_err(|m| Refusal::structural(m.0))?;
     let problems = check_scene(&next);
-    if let Some(p) = problems.iter().find(|p| !p.incomplete && !known.contains(p)) {
+    if let Some(p) = problems
+        .iter()
+        .find(|p| !p.incomplete && !known.contains(p))
+    {
         return Err(Refusal::broken(p));
     }
     Ok((next, after, problems))
@@ -230,12 +249,17 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
         Edit::SetNodeKind { node, kind } => {
             let n = g.get_mut(node).ok_or("no such node")?;
             let csg_op_change = matches!((&n.kind, &kind), (NodeKind::Csg(_), NodeKind::Csg(_)));
-            if matches!(kind, NodeKind::Triangle { .. }) && parent_of(node).is_some_and(|p| matches!(g.node(p).kind, NodeKind::Csg(_))) {
+            if matches!(kind, NodeKind::Triangle { .. })
+                && parent_of(node).is_some_and(|p| matches!(g.node(p).kind, NodeKind::Csg(_)))
+            {
                 return Err("a lone Triangle is not a solid, so it cannot be a CSG operand".into());
             }
             let n = g.get_mut(node).ok_or("no such node")?;
             if !csg_op_change && (n.kind.is_container() || kind.is_container()) {
-                return Err("only a primitive's parameters (or a CSG node's operation) can be replaced".into());
+                return Err(
+                    "only a primitive's parameters (or a CSG node's operation) can be replaced"
+                        .into(),
+                );
             }
             n.kind = kind;
         }
@@ -290,7 +314,12 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
             };
             // In the file, a Group's MaterialIndex holds for every object after it; give the
             // new last object that material, so it renders now as it will after a save.
-            let sticky = g.node(parent).children.iter().rev().find_map(|&c| g.node(c).material);
+            let sticky = g
+                .node(parent)
+                .children
+                .iter()
+                .rev()
+                .find_map(|&c| g.node(c).material);
             g.node_mut(id).material = sticky;
             g.push_child(parent, id);
             return Ok(After::SelectNode(id));
@@ -298,8 +327,15 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
         Edit::DeleteNode { node } => {
             // Deleting one operand of a CSG node leaves the other one in its place, which is
             // what "A ∪ B without B" means.
-            if let Some(csg) = parent_of(node).filter(|&p| matches!(g.node(p).kind, NodeKind::Csg(_))) {
-                let other = *g.node(csg).children.iter().find(|&&c| c != node).ok_or("a CSG node needs two operands")?;
+            if let Some(csg) =
+                parent_of(node).filter(|&p| matches!(g.node(p).kind, NodeKind::Csg(_)))
+            {
+                let other = *g
+                    .node(csg)
+                    .children
+                    .iter()
+                    .find(|&&c| c != node)
+                    .ok_or("a CSG node needs two operands")?;
                 let slot_parent = parent_of(csg).ok_or("not in the scene")?;
                 // The comments above the CSG node described the slot the survivor now fills.
                 let mut comments = g.node(csg).comments.before.clone();
@@ -373,7 +409,9 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
                 return Err("the root Group cannot be wrapped".into());
             }
             let parent = parent_of(node).ok_or("not in the scene")?;
-            if matches!(edit, Edit::WrapInGroup { .. }) && matches!(g.node(parent).kind, NodeKind::Csg(_)) {
+            if matches!(edit, Edit::WrapInGroup { .. })
+                && matches!(g.node(parent).kind, NodeKind::Csg(_))
+            {
                 return Err("a CSG operand must be a solid, and a Group is not one".into());
             }
             let kind = match edit {
@@ -438,7 +476,11 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
                 None => {
                     apply_to(scene, Edit::WrapInTransform { node })?;
                     let g = &scene.graph;
-                    g.parents().get(node.index()).copied().flatten().ok_or("not in the scene")?
+                    g.parents()
+                        .get(node.index())
+                        .copied()
+                        .flatten()
+                        .ok_or("not in the scene")?
                 }
             };
             let g = &mut scene.graph;
@@ -463,13 +505,20 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
 /// node index), so the edit changes only what it meant to. (One that rendered with the
 /// default material cannot be spelt out: the file has no MaterialIndex for it.)
 fn keep_list_colours(g: &mut Graph, list: NodeId, before: &[Option<u32>], except: Option<NodeId>) {
-    if !matches!(g.get(list).map(|n| &n.kind), Some(NodeKind::Group | NodeKind::Csg(_))) {
+    if !matches!(
+        g.get(list).map(|n| &n.kind),
+        Some(NodeKind::Group | NodeKind::Csg(_))
+    ) {
         return;
     }
     let now = g.effective_materials();
     for c in g.node(list).children.clone() {
         let was = before.get(c.index()).copied().flatten();
-        if Some(c) != except && g.node(c).material.is_none() && was.is_some() && now.get(c.index()).copied().flatten() != was {
+        if Some(c) != except
+            && g.node(c).material.is_none()
+            && was.is_some()
+            && now.get(c.index()).copied().flatten() != was
+        {
             g.node_mut(c).material = was;
         }
     }
@@ -481,7 +530,12 @@ fn keep_list_colours(g: &mut Graph, list: NodeId, before: &[Option<u32>], except
 fn settle_material(g: &mut Graph, node: NodeId, before: &[Option<u32>]) -> Result<(), Misfit> {
     let parents = g.parents();
     let parent_of = |id: NodeId| parents.get(id.index()).copied().flatten();
-    let listed = |g: &Graph, id: NodeId| matches!(g.get(id).map(|n| &n.kind), Some(NodeKind::Group | NodeKind::Csg(_)));
+    let listed = |g: &Graph, id: NodeId| {
+        matches!(
+            g.get(id).map(|n| &n.kind),
+            Some(NodeKind::Group | NodeKind::Csg(_))
+        )
+    };
     let mut slot = node;
     let list = loop {
         let p = parent_of(slot).ok_or("not in the scene")?;
@@ -581,12 +635,23 @@ Group {
 ";
 
     fn parsed() -> Scene {
-        let out = tracelab_core::parse_scene(SCENE.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new());
+        let out = tracelab_core::parse_scene(
+            SCENE.as_bytes(),
+            "s.txt",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        );
         out.scene.expect("parses")
     }
 
     fn node_of(scene: &Scene, kind: &str, nth: usize) -> NodeId {
-        scene.graph.iter().filter(|(_, n)| n.kind.name() == kind).nth(nth).map(|(id, _)| id).expect("node")
+        scene
+            .graph
+            .iter()
+            .filter(|(_, n)| n.kind.name() == kind)
+            .nth(nth)
+            .map(|(id, _)| id)
+            .expect("node")
     }
 
     fn written(scene: &Scene) -> String {
@@ -614,18 +679,34 @@ Group {
         assert!(text.contains("    # the keeper\n    Group {\n"), "{text}");
         let mut d = parsed();
         apply_to(&mut d, Edit::DuplicateNode { node: keeper }).expect("duplicates");
-        assert_eq!(written(&d).matches("# the keeper").count(), 2, "a copy carries its comments");
+        assert_eq!(
+            written(&d).matches("# the keeper").count(),
+            2,
+            "a copy carries its comments"
+        );
     }
 
     #[test]
     fn op_comments_follow_their_ops() {
         let mut s = parsed();
         let t = node_of(&s, "Transform", 0);
-        apply_to(&mut s, Edit::MoveOp { node: t, from: 0, to: 1 }).expect("moves");
+        apply_to(
+            &mut s,
+            Edit::MoveOp {
+                node: t,
+                from: 0,
+                to: 1,
+            },
+        )
+        .expect("moves");
         assert!(written(&s).contains("        # second op\n        Scale 1 2 1\n        # first op\n        Translate 1 0 0\n"), "{}", written(&s));
         apply_to(&mut s, Edit::RemoveOp { node: t, index: 0 }).expect("removes");
         let text = written(&s);
-        assert!(!text.contains("second op") && text.contains("        # first op\n        Translate 1 0 0\n"), "{text}");
+        assert!(
+            !text.contains("second op")
+                && text.contains("        # first op\n        Translate 1 0 0\n"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -634,16 +715,44 @@ Group {
 Materials { numMaterials 3 Material { diffuseColor 1 0 0 } Material { diffuseColor 0 1 0 } Material { diffuseColor 0 0 1 } }
 Group { numObjects 3 MaterialIndex 1 Sphere { center -2 0 0 radius 1 } MaterialIndex 2 Sphere { center 0 0 0 radius 1 } Sphere { center 2 0 0 radius 1 } }
 ";
-        let mut s = tracelab_core::parse_scene(text.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new()).scene.expect("parses");
-        let [_, d, b] = s.graph.node(s.graph.root()).children[..] else { panic!("three spheres") };
+        let mut s = tracelab_core::parse_scene(
+            text.as_bytes(),
+            "s.txt",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        )
+        .scene
+        .expect("parses");
+        let [_, d, b] = s.graph.node(s.graph.root()).children[..] else {
+            panic!("three spheres")
+        };
         // B sets none of its own: it continues D's Material 2.
-        apply_to(&mut s, Edit::SetNodeMaterial { node: b, material: None }).expect("applies");
+        apply_to(
+            &mut s,
+            Edit::SetNodeMaterial {
+                node: b,
+                material: None,
+            },
+        )
+        .expect("applies");
         assert_eq!(s.graph.effective_materials()[b.index()], Some(2));
         let mut moved = s.clone();
         apply_to(&mut s, Edit::DeleteNode { node: d }).expect("deletes");
-        assert_eq!(s.graph.effective_materials()[b.index()], Some(2), "B would have continued Material 1");
+        assert_eq!(
+            s.graph.effective_materials()[b.index()],
+            Some(2),
+            "B would have continued Material 1"
+        );
         let root = moved.graph.root();
-        apply_to(&mut moved, Edit::MoveNode { node: d, new_parent: root, index: usize::MAX }).expect("moves");
+        apply_to(
+            &mut moved,
+            Edit::MoveNode {
+                node: d,
+                new_parent: root,
+                index: usize::MAX,
+            },
+        )
+        .expect("moves");
         let m = moved.graph.effective_materials();
         assert_eq!((m[b.index()], m[d.index()]), (Some(2), Some(2)));
     }
@@ -651,9 +760,20 @@ Group { numObjects 3 MaterialIndex 1 Sphere { center -2 0 0 radius 1 } MaterialI
     #[test]
     fn deleting_a_csg_operand_keeps_the_comments_above_the_csg_node() {
         let text = SCENE.replace("numObjects 2", "numObjects 3\n    # the union\n    Union { Sphere { center 0 0 0 radius 1 } Box { min 0 0 0 max 1 1 1 } }");
-        let mut s = tracelab_core::parse_scene(text.as_bytes(), "s.txt", None, &mut tracelab_core::MeshCache::new()).scene.expect("parses");
+        let mut s = tracelab_core::parse_scene(
+            text.as_bytes(),
+            "s.txt",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        )
+        .scene
+        .expect("parses");
         let b = node_of(&s, "Box", 0);
         apply_to(&mut s, Edit::DeleteNode { node: b }).expect("deletes");
-        assert!(written(&s).contains("    # the union\n    Sphere {"), "{}", written(&s));
+        assert!(
+            written(&s).contains("    # the union\n    Sphere {"),
+            "{}",
+            written(&s)
+        );
     }
 }

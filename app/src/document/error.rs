@@ -21,7 +21,10 @@ pub enum SaveError {
     #[error("{}: not saved, because {why} (a tracelab bug; please report it)", .path.display())]
     WouldNotReadBack { path: PathBuf, why: String },
     #[error("{}: cannot write: {source}", .path.display())]
-    Write { path: PathBuf, source: std::io::Error },
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// An edit that does not fit the scene's structure (a stale id, an index out of range, a

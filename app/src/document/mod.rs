@@ -7,8 +7,8 @@ use std::time::SystemTime;
 use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check_scene};
 
 pub mod edit;
-pub mod op_target;
 mod error;
+pub mod op_target;
 
 pub use error::{Misfit, OpenError, SaveError};
 
@@ -261,7 +261,10 @@ impl Document {
             }
             Err(e) => MeshSlot::Failed(e.to_string()),
         };
-        self.apply(Edit::SetNodeKind { node, kind: NodeKind::TriangleMesh { obj_file, mesh } })
+        self.apply(Edit::SetNodeKind {
+            node,
+            kind: NodeKind::TriangleMesh { obj_file, mesh },
+        })
     }
 
     /// Drops a selection that no longer points at anything.
@@ -294,9 +297,17 @@ impl Document {
     /// Replaces the document by a scene read with [`read_scene_file`], adopting its mesh
     /// cache; a file that could not be read leaves the scene and reports why.
     pub fn install(&mut self, read: SceneRead) -> Result<(), OpenError> {
-        let SceneRead { path, outcome, cache } = read;
+        let SceneRead {
+            path,
+            outcome,
+            cache,
+        } = read;
         match outcome {
-            Ok(Opened { scene, messages, lost_comments }) => {
+            Ok(Opened {
+                scene,
+                messages,
+                lost_comments,
+            }) => {
                 let generation = self.generation + 1;
                 *self = Document::new(scene, Some(path));
                 self.mesh_cache = cache;
@@ -320,14 +331,20 @@ impl Document {
     pub fn save_warnings(&self, path: &Path) -> Vec<String> {
         let mut scene = self.scene.clone();
         let mut out = self.lost_comments.clone();
-        out.extend(tracelab_core::rebase_mesh_paths(&mut scene, &self.folder(), &folder_of(path)));
+        out.extend(tracelab_core::rebase_mesh_paths(
+            &mut scene,
+            &self.folder(),
+            &folder_of(path),
+        ));
         out
     }
 
     /// Where relative `obj_file` paths of the document resolve from: its file's folder, or
     /// the current folder for a scene never saved.
     fn folder(&self) -> PathBuf {
-        self.path.as_deref().map_or_else(|| PathBuf::from("."), folder_of)
+        self.path
+            .as_deref()
+            .map_or_else(|| PathBuf::from("."), folder_of)
     }
 
     /// Writes the scene atomically (temporary file + rename) and marks it saved. Relative
@@ -341,8 +358,10 @@ impl Document {
         let mut scene = self.scene.clone();
         tracelab_core::rebase_mesh_paths(&mut scene, &from, &to);
         let text = self.checked_text(&scene, path)?;
-        crate::io::write_atomic(path, text.as_bytes())
-            .map_err(|source| SaveError::Write { path: path.to_path_buf(), source })?;
+        crate::io::write_atomic(path, text.as_bytes()).map_err(|source| SaveError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
         self.scene = scene;
         self.problems = check_scene(&self.scene);
         for s in self.undo.iter_mut().chain(self.redo.iter_mut()) {
@@ -369,10 +388,11 @@ impl Document {
     /// required to be the same document.
     fn checked_text(&mut self, scene: &Scene, path: &Path) -> Result<String, SaveError> {
         let name = path.display().to_string();
-        let text = tracelab_core::try_write_scene(scene).map_err(|problems| SaveError::BreaksRules {
-            path: path.to_path_buf(),
-            fix: problems.into_iter().map(|p| p.message).collect(),
-        })?;
+        let text =
+            tracelab_core::try_write_scene(scene).map_err(|problems| SaveError::BreaksRules {
+                path: path.to_path_buf(),
+                fix: problems.into_iter().map(|p| p.message).collect(),
+            })?;
         let back = tracelab_core::parse_scene_unresolved(text.as_bytes(), &name);
         let why = match back.scene {
             // Node errors (an OBJ that does not load) open too, as they did here.
@@ -380,7 +400,10 @@ impl Document {
             None => Some(format!("it would not open again:\n{}", back.diagnostics)),
         };
         match why {
-            Some(why) => Err(SaveError::WouldNotReadBack { path: path.to_path_buf(), why }),
+            Some(why) => Err(SaveError::WouldNotReadBack {
+                path: path.to_path_buf(),
+                why,
+            }),
             None => Ok(text),
         }
     }
@@ -402,7 +425,8 @@ impl Document {
 }
 
 fn folder_of(file: &Path) -> PathBuf {
-    file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+    file.parent()
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
 fn modified(p: &Path) -> Option<SystemTime> {
@@ -411,9 +435,9 @@ fn modified(p: &Path) -> Option<SystemTime> {
 
 #[cfg(test)]
 mod tests {
+    use super::edit::Edit;
     use super::*;
     use crate::test_support::names_in;
-    use super::edit::Edit;
     use tracelab_core::NodeKind;
 
     fn temp_dir(name: &str) -> PathBuf {
@@ -441,7 +465,11 @@ mod tests {
         let mut doc = Document::new(Scene::default(), None);
         doc.open(&d.join("scenes/s.txt")).expect("opens");
         let root = doc.scene.graph.root();
-        doc.apply(Edit::SetNodeMaterial { node: doc.scene.graph.node(root).children[0], material: None }).expect("an edit to undo");
+        doc.apply(Edit::SetNodeMaterial {
+            node: doc.scene.graph.node(root).children[0],
+            material: None,
+        })
+        .expect("an edit to undo");
         let out = d.join("out/sub/s.txt");
         assert!(doc.save_warnings(&out).is_empty());
         doc.save_as(&out).expect("saves");
@@ -449,34 +477,49 @@ mod tests {
         assert!(text.starts_with("# header\n"), "{text}");
         assert!(text.contains("obj_file ../../scenes/mesh.obj\n"), "{text}");
         // The saved file finds its mesh from its own folder (the tests' working folder has none).
-        let (saved, _) = tracelab_core::load_scene(&out, &mut MeshCache::new()).into_result().expect("loads");
-        assert!(saved.graph.iter().any(|(_, n)| matches!(&n.kind, NodeKind::TriangleMesh { mesh, .. } if mesh.mesh().is_some())));
+        let (saved, _) = tracelab_core::load_scene(&out, &mut MeshCache::new())
+            .into_result()
+            .expect("loads");
+        assert!(saved.graph.iter().any(
+            |(_, n)| matches!(&n.kind, NodeKind::TriangleMesh { mesh, .. } if mesh.mesh().is_some())
+        ));
         // The document and its history now speak relative to the new folder.
-        assert_eq!(obj_file(&doc.scene).as_deref(), Some("../../scenes/mesh.obj"));
+        assert_eq!(
+            obj_file(&doc.scene).as_deref(),
+            Some("../../scenes/mesh.obj")
+        );
         assert!(doc.undo());
-        assert_eq!(obj_file(&doc.scene).as_deref(), Some("../../scenes/mesh.obj"));
+        assert_eq!(
+            obj_file(&doc.scene).as_deref(),
+            Some("../../scenes/mesh.obj")
+        );
     }
 
     #[test]
     fn save_warnings_name_comments_the_save_drops() {
         let d = temp_dir("lost");
-        let text = SCENE.replace("angle 40", "angle # forty\n 40").replace("mesh.obj", "/nonexistent/mesh.obj");
+        let text = SCENE
+            .replace("angle 40", "angle # forty\n 40")
+            .replace("mesh.obj", "/nonexistent/mesh.obj");
         std::fs::write(d.join("scenes/s.txt"), text).expect("scene");
         let mut doc = Document::new(Scene::default(), None);
-        doc.open(&d.join("scenes/s.txt")).expect("opens with a missing mesh");
+        doc.open(&d.join("scenes/s.txt"))
+            .expect("opens with a missing mesh");
         let w = doc.save_warnings(&d.join("scenes/s.txt"));
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].contains("s.txt:2:") && w[0].contains("comment"), "{w:?}");
+        assert!(
+            w[0].contains("s.txt:2:") && w[0].contains("comment"),
+            "{w:?}"
+        );
     }
 
     fn empty_dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("tracelab-state-io-{}-{name}", std::process::id()));
+        let d =
+            std::env::temp_dir().join(format!("tracelab-state-io-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).expect("temp dir");
         d
     }
-
-
 
     #[test]
     fn an_incomplete_mesh_is_listed_and_keeps_save_from_writing_until_it_names_a_file() {
@@ -486,21 +529,58 @@ mod tests {
         let mut doc = Document::builtin();
         doc.open(&p).expect("open");
         let root = doc.scene.graph.root();
-        let mesh = |obj_file: &str| NodeKind::TriangleMesh { obj_file: obj_file.into(), mesh: tracelab_core::MeshSlot::Failed(String::new()) };
-        doc.apply(Edit::AddNode { parent: root, kind: mesh("") }).expect("an incomplete node is allowed");
-        let Some(Selection::Node(id)) = doc.selection else { panic!("the new node is selected") };
-        let incomplete: Vec<_> = doc.incomplete().map(|p| (p.node(), p.reason.clone())).collect();
-        assert_eq!(incomplete, [(Some(id), "TriangleMesh: no OBJ file chosen yet".to_string())]);
+        let mesh = |obj_file: &str| NodeKind::TriangleMesh {
+            obj_file: obj_file.into(),
+            mesh: tracelab_core::MeshSlot::Failed(String::new()),
+        };
+        doc.apply(Edit::AddNode {
+            parent: root,
+            kind: mesh(""),
+        })
+        .expect("an incomplete node is allowed");
+        let Some(Selection::Node(id)) = doc.selection else {
+            panic!("the new node is selected")
+        };
+        let incomplete: Vec<_> = doc
+            .incomplete()
+            .map(|p| (p.node(), p.reason.clone()))
+            .collect();
+        assert_eq!(
+            incomplete,
+            [(Some(id), "TriangleMesh: no OBJ file chosen yet".to_string())]
+        );
         let e = doc.save().expect_err("nothing to write yet").to_string();
-        assert!(e.contains("not saved") && e.contains("no OBJ file chosen yet"), "{e}");
-        assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);
+        assert!(
+            e.contains("not saved") && e.contains("no OBJ file chosen yet"),
+            "{e}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&p).expect("read"),
+            crate::DEFAULT_SCENE
+        );
         // A name that cannot be written is refused outright; a missing file is only a node error.
-        let refused = doc.apply(Edit::SetNodeKind { node: id, kind: mesh("my mesh.obj") }).expect_err("a space");
-        assert_eq!((refused.place, refused.field.as_str()), (Some(tracelab_core::Place::Node(id)), "obj_file"));
-        doc.apply(Edit::SetNodeKind { node: id, kind: mesh("elsewhere.obj") }).expect("a name");
+        let refused = doc
+            .apply(Edit::SetNodeKind {
+                node: id,
+                kind: mesh("my mesh.obj"),
+            })
+            .expect_err("a space");
+        assert_eq!(
+            (refused.place, refused.field.as_str()),
+            (Some(tracelab_core::Place::Node(id)), "obj_file")
+        );
+        doc.apply(Edit::SetNodeKind {
+            node: id,
+            kind: mesh("elsewhere.obj"),
+        })
+        .expect("a name");
         assert_eq!(doc.incomplete().count(), 0);
         doc.save().expect("saves");
-        assert!(std::fs::read_to_string(&p).expect("read").contains("obj_file elsewhere.obj"));
+        assert!(
+            std::fs::read_to_string(&p)
+                .expect("read")
+                .contains("obj_file elsewhere.obj")
+        );
     }
 
     #[cfg(unix)]
@@ -514,7 +594,10 @@ mod tests {
         let mut doc = Document::builtin();
         doc.open(&p).expect("open");
         doc.save().expect("save");
-        assert_eq!(std::fs::metadata(&p).expect("meta").permissions().mode() & 0o7777, 0o600);
+        assert_eq!(
+            std::fs::metadata(&p).expect("meta").permissions().mode() & 0o7777,
+            0o600
+        );
         assert_eq!(names_in(&d), ["scene.txt"]);
     }
 
@@ -529,7 +612,12 @@ mod tests {
         doc.open(&d.join("link.txt")).expect("open");
         doc.scene.background.color = Some(glam::Vec3::new(0.25, 0.5, 0.75));
         doc.save().expect("save");
-        assert!(std::fs::symlink_metadata(d.join("link.txt")).expect("meta").file_type().is_symlink());
+        assert!(
+            std::fs::symlink_metadata(d.join("link.txt"))
+                .expect("meta")
+                .file_type()
+                .is_symlink()
+        );
         let text = std::fs::read_to_string(d.join("real/scene.txt")).expect("read");
         assert!(text.contains("0.25 0.5 0.75"), "{text}");
         assert_eq!(names_in(&d), ["link.txt", "real"]);
@@ -543,10 +631,16 @@ mod tests {
         std::fs::write(&p, crate::DEFAULT_SCENE).expect("write");
         let mut doc = Document::builtin();
         doc.open(&p).expect("open");
-        let e = doc.save_as(&d.join("gone/scene.txt")).expect_err("no such folder").to_string();
+        let e = doc
+            .save_as(&d.join("gone/scene.txt"))
+            .expect_err("no such folder")
+            .to_string();
         assert!(e.contains("cannot write"), "{e}");
         assert_eq!(doc.path.as_deref(), Some(p.as_path()));
-        assert_eq!(std::fs::read_to_string(&p).expect("read"), crate::DEFAULT_SCENE);
+        assert_eq!(
+            std::fs::read_to_string(&p).expect("read"),
+            crate::DEFAULT_SCENE
+        );
         assert_eq!(names_in(&d), ["scene.txt"]);
     }
 
@@ -559,7 +653,10 @@ mod tests {
     impl Drop for LockedDir {
         fn drop(&mut self) {
             use std::os::unix::fs::PermissionsExt;
-            let _ = std::process::Command::new("chattr").arg("-i").arg(&self.0).status();
+            let _ = std::process::Command::new("chattr")
+                .arg("-i")
+                .arg(&self.0)
+                .status();
             let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
         }
     }
@@ -575,10 +672,16 @@ mod tests {
         doc.path = Some(p.clone());
         let lock = LockedDir(d.clone());
         std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o555)).expect("chmod");
-        let _ = std::process::Command::new("chattr").arg("+i").arg(&d).status();
+        let _ = std::process::Command::new("chattr")
+            .arg("+i")
+            .arg(&d)
+            .status();
         let probe = std::fs::File::create(d.join("probe")).is_ok();
         let _ = std::fs::remove_file(d.join("probe"));
-        assert!(!probe, "cannot make a folder that refuses new files here (root without chattr +i): this test needs mode 0555 to hold, or chattr");
+        assert!(
+            !probe,
+            "cannot make a folder that refuses new files here (root without chattr +i): this test needs mode 0555 to hold, or chattr"
+        );
         assert!(doc.save().is_err(), "saving into a locked folder fails");
         drop(lock);
         assert_eq!(std::fs::read_to_string(&p).expect("read"), "old text");

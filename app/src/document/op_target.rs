@@ -60,8 +60,15 @@ impl OpTarget {
     pub fn added(&self, kind: OpKind, node_name: &str) -> Option<String> {
         match (self.transform, self.exists) {
             (_, true) => None,
-            (None, _) => Some(format!("wrapped the {node_name} in a new Transform with {}", kind.name())),
-            (Some(_), false) => Some(format!("added {} as op {} of the Transform", kind.name(), self.index + 1)),
+            (None, _) => Some(format!(
+                "wrapped the {node_name} in a new Transform with {}",
+                kind.name()
+            )),
+            (Some(_), false) => Some(format!(
+                "added {} as op {} of the Transform",
+                kind.name(),
+                self.index + 1
+            )),
         }
     }
 
@@ -91,16 +98,29 @@ pub fn op_target(g: &Graph, node: NodeId, kind: OpKind) -> Result<OpTarget, supe
         _ => Vec::new(),
     };
     if let Some(i) = ops.iter().position(|o| OpKind::of(o) == Some(kind)) {
-        return Ok(OpTarget { transform, index: i, exists: true, ops });
+        return Ok(OpTarget {
+            transform,
+            index: i,
+            exists: true,
+            ops,
+        });
     }
     // T · R · S: the translation outermost (first listed, applied last), in the space
     // around the Transform; the rotation after the leading translations; the scale last.
     let index = match kind {
         OpKind::Translate => 0,
-        OpKind::ZRotate => ops.iter().take_while(|o| matches!(o, TransformOp::Translate(_))).count(),
+        OpKind::ZRotate => ops
+            .iter()
+            .take_while(|o| matches!(o, TransformOp::Translate(_)))
+            .count(),
         OpKind::Scale => ops.len(),
     };
-    Ok(OpTarget { transform, index, exists: false, ops })
+    Ok(OpTarget {
+        transform,
+        index,
+        exists: false,
+        ops,
+    })
 }
 
 #[cfg(test)]
@@ -111,7 +131,10 @@ mod tests {
 
     fn chain(ops: Vec<TransformOp>) -> (Graph, NodeId, NodeId) {
         let mut g = Graph::new();
-        let s = g.add(Node::new(NodeKind::Sphere { center: Vec3::ZERO, radius: 1.0 }));
+        let s = g.add(Node::new(NodeKind::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        }));
         let t = g.add(Node::new(NodeKind::Transform(ops)));
         g.push_child(t, s);
         let root = g.root();
@@ -121,7 +144,10 @@ mod tests {
 
     #[test]
     fn missing_ops_go_in_t_r_s_order_and_existing_ones_are_found() {
-        let (g, t, s) = chain(vec![TransformOp::Translate(Vec3::X), TransformOp::UniformScale(2.0)]);
+        let (g, t, s) = chain(vec![
+            TransformOp::Translate(Vec3::X),
+            TransformOp::UniformScale(2.0),
+        ]);
         let r = op_target(&g, s, OpKind::ZRotate).expect("target");
         assert_eq!((r.transform, r.index, r.exists), (Some(t), 1, false));
         let sc = op_target(&g, t, OpKind::Scale).expect("target");
@@ -129,18 +155,28 @@ mod tests {
         let tr = op_target(&g, s, OpKind::Translate).expect("target");
         assert_eq!((tr.index, tr.exists), (0, true));
         let (g, _, s) = chain(vec![TransformOp::Scale(Vec3::ONE * 2.0)]);
-        assert_eq!(op_target(&g, s, OpKind::Translate).expect("target").index, 0);
+        assert_eq!(
+            op_target(&g, s, OpKind::Translate).expect("target").index,
+            0
+        );
     }
 
     #[test]
     fn a_node_without_a_transform_parent_gets_a_new_one() {
         let mut g = Graph::new();
-        let s = g.add(Node::new(NodeKind::Sphere { center: Vec3::ZERO, radius: 1.0 }));
+        let s = g.add(Node::new(NodeKind::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        }));
         let root = g.root();
         g.push_child(root, s);
         let r = op_target(&g, s, OpKind::Translate).expect("target");
         assert_eq!((r.transform, r.index, r.exists), (None, 0, false));
-        assert!(r.added(OpKind::Translate, "Sphere").expect("says").contains("new Transform"));
+        assert!(
+            r.added(OpKind::Translate, "Sphere")
+                .expect("says")
+                .contains("new Transform")
+        );
         assert!(op_target(&g, root, OpKind::Translate).is_err());
     }
 }

@@ -27,17 +27,38 @@ impl Running {
         let (tx, rx) = channel();
         let done = Arc::new(AtomicU32::new(0));
         let cancel = Arc::new(AtomicBool::new(false));
-        let (d, c, sweep, compare, folder) = (done.clone(), cancel.clone(), form.sweep(), form.compare, PathBuf::from(&form.folder));
+        let (d, c, sweep, compare, folder) = (
+            done.clone(),
+            cancel.clone(),
+            form.sweep(),
+            form.compare,
+            PathBuf::from(&form.folder),
+        );
         std::thread::spawn(move || {
-            let out = match render_frames(&scene, &sweep, &settings, compare, &c, |k| d.store(k, Ordering::Relaxed)) {
-                Ok(frames) => write_frames(&frames, &folder, "frame", 100)
-                    .map(|files| format!("exported {} frames to {} ({})", frames.len(), folder.display(), files.last().map_or(String::new(), |f| f.display().to_string()))),
+            let out = match render_frames(&scene, &sweep, &settings, compare, &c, |k| {
+                d.store(k, Ordering::Relaxed)
+            }) {
+                Ok(frames) => write_frames(&frames, &folder, "frame", 100).map(|files| {
+                    format!(
+                        "exported {} frames to {} ({})",
+                        frames.len(),
+                        folder.display(),
+                        files
+                            .last()
+                            .map_or(String::new(), |f| f.display().to_string())
+                    )
+                }),
                 Err(AnimateError::Cancelled) => Err("animation export cancelled".into()),
                 Err(AnimateError::Refused(m)) => Err(format!("animation not exported: {m}")),
             };
             let _ = tx.send(out);
         });
-        Running { done, total: form.frames, cancel, result: rx }
+        Running {
+            done,
+            total: form.frames,
+            cancel,
+            result: rx,
+        }
     }
 
     /// The message once finished.
@@ -47,7 +68,12 @@ impl Running {
 }
 
 /// The form as a window; returns the command its buttons ask for.
-pub fn ui(ctx: &egui::Context, form: &mut AnimationForm, scene: &Scene, running: Option<&Running>) -> Option<AppCommand> {
+pub fn ui(
+    ctx: &egui::Context,
+    form: &mut AnimationForm,
+    scene: &Scene,
+    running: Option<&Running>,
+) -> Option<AppCommand> {
     let mut asked = None;
     let ops = match scene.graph.get(form.node).map(|n| &n.kind) {
         Some(NodeKind::Transform(ops)) => ops.clone(),

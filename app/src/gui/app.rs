@@ -6,32 +6,32 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use tracelab_core::{NodeKind, Scene};
 use tracelab_core::render::RayStory;
+use tracelab_core::{NodeKind, Scene};
 
 use crate::document::edit::Edit;
 use crate::document::op_target::{OpKind, op_target};
-use crate::gui::{bounds, navigation};
-use glam::Vec3;
-use crate::gui::loading::{LoadPurpose, Loading};
-use crate::render_worker::RenderWorker;
 use crate::document::{Document, Selection};
-use crate::io::{SceneRead, read_scene_file};
+use crate::gui::animation_dialog::{self, AnimationForm};
 use crate::gui::command::AppCommand;
 use crate::gui::file_dialog::{FileDialog, Purpose};
-use crate::gui::layout::Layout;
 use crate::gui::file_watch::{self, FileWatch};
+use crate::gui::layout::Layout;
+use crate::gui::lecture;
+use crate::gui::loading::{LoadPurpose, Loading};
 use crate::gui::menu;
-use crate::gui::view_tools;
-use crate::gui::settings::Settings;
 use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
 use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
 use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree};
-use crate::gui::animation_dialog::{self, AnimationForm};
-use crate::gui::lecture;
 use crate::gui::ray_diagram::Orbit;
+use crate::gui::settings::Settings;
+use crate::gui::view_tools;
+use crate::gui::{bounds, navigation};
+use crate::io::{SceneRead, read_scene_file};
+use crate::render_worker::RenderWorker;
+use glam::Vec3;
 
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -54,7 +54,11 @@ pub enum Pending {
     /// Start a new untitled scene, over unsaved changes.
     New,
     /// Write `path` although saving loses what `warnings` name; then carry on with `then`.
-    Save { path: PathBuf, warnings: Vec<String>, then: Option<Box<Pending>> },
+    Save {
+        path: PathBuf,
+        warnings: Vec<String>,
+        then: Option<Box<Pending>>,
+    },
 }
 
 const MAX_RECENT: usize = 10;
@@ -188,7 +192,13 @@ impl TracelabApp {
     }
 
     fn apply_settings(&mut self, s: Settings) {
-        let Settings { recent, tab, shade_back, depth, layout_epoch } = s;
+        let Settings {
+            recent,
+            tab,
+            shade_back,
+            depth,
+            layout_epoch,
+        } = s;
         self.recent = recent;
         self.view.tab = tab;
         self.view.shade_back = shade_back;
@@ -257,16 +267,28 @@ impl TracelabApp {
             }
             AppCommand::CloseCaption => self.lecture = None,
             AppCommand::AnimationDialog => match self.doc.selection {
-                Some(Selection::Node(id)) if matches!(self.doc.scene.graph.get(id).map(|n| &n.kind), Some(NodeKind::Transform(_))) => {
+                Some(Selection::Node(id))
+                    if matches!(
+                        self.doc.scene.graph.get(id).map(|n| &n.kind),
+                        Some(NodeKind::Transform(_))
+                    ) =>
+                {
                     self.animation = Some(AnimationForm::new(id));
                 }
-                _ => self.doc.messages.push("Export animation: select a Transform first".into()),
+                _ => self
+                    .doc
+                    .messages
+                    .push("Export animation: select a Transform first".into()),
             },
             AppCommand::StartAnimation(form) => {
                 if self.animation_running.is_none() {
                     let size = self.view.fixed_size.unwrap_or(self.viewport.shown_size);
                     let settings = Viewport::settings(&self.view, size);
-                    self.animation_running = Some(animation_dialog::Running::start(Arc::new(self.doc.scene.clone()), &form, settings));
+                    self.animation_running = Some(animation_dialog::Running::start(
+                        Arc::new(self.doc.scene.clone()),
+                        &form,
+                        settings,
+                    ));
                     self.animation = Some(form);
                 }
             }
@@ -283,7 +305,11 @@ impl TracelabApp {
             AppCommand::Export(p) => match self.export(&p) {
                 Ok(files) => self.doc.messages.push(format!(
                     "exported {}",
-                    files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+                    files
+                        .iter()
+                        .map(|f| f.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )),
                 Err(e) => self.doc.messages.push(e.to_string()),
             },
@@ -300,14 +326,25 @@ impl TracelabApp {
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {
                 Some(Selection::Node(id)) => self.frame_node(id),
-                _ => self.doc.messages.push("Frame selected: select an object first".into()),
+                _ => self
+                    .doc
+                    .messages
+                    .push("Frame selected: select an object first".into()),
             },
             AppCommand::FrameAll => self.frame_node(self.doc.scene.graph.root()),
             AppCommand::AxisView(v) => {
                 let root = self.doc.scene.graph.root();
-                let (lo, hi) = bounds::world_bounds(&self.doc.scene, root).unwrap_or((Vec3::splat(-1.0), Vec3::ONE));
+                let (lo, hi) = bounds::world_bounds(&self.doc.scene, root)
+                    .unwrap_or((Vec3::splat(-1.0), Vec3::ONE));
                 let (w, h) = self.render_size;
-                self.apply(Edit::SetCamera(navigation::axis_view(&self.doc.scene.camera, v, lo, hi, w, h)));
+                self.apply(Edit::SetCamera(navigation::axis_view(
+                    &self.doc.scene.camera,
+                    v,
+                    lo,
+                    hi,
+                    w,
+                    h,
+                )));
             }
             AppCommand::CancelDrag { mark } => {
                 self.doc.revert_to(mark);
@@ -320,9 +357,18 @@ impl TracelabApp {
         match bounds::world_bounds(&self.doc.scene, node) {
             Some((lo, hi)) => {
                 let (w, h) = self.render_size;
-                self.apply(Edit::SetCamera(navigation::frame(&self.doc.scene.camera, lo, hi, w, h)));
+                self.apply(Edit::SetCamera(navigation::frame(
+                    &self.doc.scene.camera,
+                    lo,
+                    hi,
+                    w,
+                    h,
+                )));
             }
-            None => self.doc.messages.push("nothing with bounds to frame there (a plane has none)".into()),
+            None => self
+                .doc
+                .messages
+                .push("nothing with bounds to frame there (a plane has none)".into()),
         }
     }
 
@@ -373,7 +419,12 @@ impl TracelabApp {
         if let Some(old) = self.loading.take() {
             old.cancel();
         }
-        self.loading = Some(Loading::start(path, purpose, self.doc.mesh_cache.clone(), self.repaint.clone()));
+        self.loading = Some(Loading::start(
+            path,
+            purpose,
+            self.doc.mesh_cache.clone(),
+            self.repaint.clone(),
+        ));
     }
 
     /// Stops the background read; the open scene stays as it is.
@@ -495,7 +546,11 @@ impl TracelabApp {
     fn save_to(&mut self, path: &Path, then: Option<Pending>) -> bool {
         let warnings = self.doc.save_warnings(path);
         if !warnings.is_empty() {
-            self.confirm = Some(Pending::Save { path: path.to_path_buf(), warnings, then: then.map(Box::new) });
+            self.confirm = Some(Pending::Save {
+                path: path.to_path_buf(),
+                warnings,
+                then: then.map(Box::new),
+            });
             return false;
         }
         self.write(path)
@@ -544,7 +599,12 @@ impl TracelabApp {
             let p = p.ok_or_else(|| anyhow::anyhow!("nothing rendered yet"))?;
             let mut written = Vec::new();
             for (f, view, _) in &cells {
-                let frame = p.frames.get(*f).ok_or_else(|| anyhow::anyhow!("no such frame"))?.lock().clone();
+                let frame = p
+                    .frames
+                    .get(*f)
+                    .ok_or_else(|| anyhow::anyhow!("no such frame"))?
+                    .lock()
+                    .clone();
                 let target = if many {
                     let v = match view {
                         tracelab_core::View::Color => "color",
@@ -570,7 +630,9 @@ impl TracelabApp {
     /// Inspects a pixel of the image last published (the image on screen) and selects
     /// what it shows.
     pub fn inspect(&mut self, frame: usize, x: u32, row: u32) {
-        let found = self.worker.with_published(|p| pixel_inspector::trace(p?, frame, x, row));
+        let found = self
+            .worker
+            .with_published(|p| pixel_inspector::trace(p?, frame, x, row));
         if let Some((at, story, scene)) = found {
             if let Some(h) = &story.hit {
                 // Ids are stable across edits that do not delete the node.
@@ -589,7 +651,10 @@ impl TracelabApp {
     /// always that of the image on screen. The selection stays as the user left it.
     fn follow_inspected(&mut self) {
         let Some(at) = self.inspected else { return };
-        if let Some((at, story, scene)) = self.worker.with_published(|p| pixel_inspector::follow(p?, &at)) {
+        if let Some((at, story, scene)) = self
+            .worker
+            .with_published(|p| pixel_inspector::follow(p?, &at))
+        {
             self.viewport.marker = Some((at.x, at.row));
             self.inspected = Some(at);
             self.story = Some((story, scene));
@@ -775,12 +840,17 @@ impl TracelabApp {
     }
 
     fn dialogs(&mut self, ctx: &egui::Context) {
-        if let Some(msg) = self.animation_running.as_ref().and_then(animation_dialog::Running::poll) {
+        if let Some(msg) = self
+            .animation_running
+            .as_ref()
+            .and_then(animation_dialog::Running::poll)
+        {
             self.animation_running = None;
             self.doc.messages.push(msg.unwrap_or_else(|e| e));
         }
         if let Some(form) = &mut self.animation
-            && let Some(c) = animation_dialog::ui(ctx, form, &self.doc.scene, self.animation_running.as_ref())
+            && let Some(c) =
+                animation_dialog::ui(ctx, form, &self.doc.scene, self.animation_running.as_ref())
         {
             self.queue(c);
         }
@@ -810,7 +880,11 @@ impl TracelabApp {
             }
         }
         match self.confirm.clone() {
-            Some(Pending::Save { path, warnings, then }) => {
+            Some(Pending::Save {
+                path,
+                warnings,
+                then,
+            }) => {
                 let mut choice = None;
                 egui::Modal::new(egui::Id::unique("save-loses")).show(ctx, |ui| {
                     ui.heading("Saving loses something");
@@ -833,7 +907,14 @@ impl TracelabApp {
                 if let Some(yes) = choice {
                     self.confirm = None;
                     if yes {
-                        self.carry_out(Pending::Save { path, warnings, then }, ctx);
+                        self.carry_out(
+                            Pending::Save {
+                                path,
+                                warnings,
+                                then,
+                            },
+                            ctx,
+                        );
                     } else if then.is_some() {
                         // Not saved: whatever was to follow waits for another answer.
                         self.ready = None;
@@ -896,7 +977,8 @@ impl TracelabApp {
 
     /// Watches the file: reload quietly when nothing is unsaved, else ask.
     fn watch_disk(&mut self) {
-        self.file_watch.follow(self.doc.path.as_deref(), self.repaint.clone());
+        self.file_watch
+            .follow(self.doc.path.as_deref(), self.repaint.clone());
         // A read under way will set the stamp; asking again would restart it. (A change
         // seen meanwhile stays pending until it is done.)
         if self.loading.is_some() || !self.file_watch.take_changed() {
@@ -978,8 +1060,19 @@ impl TracelabApp {
         });
         self.run_commands(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| {
-            let note = self.note.as_ref().filter(|(_, t)| t.elapsed() < Duration::from_secs(10)).map(|(n, _)| n.as_str());
-            status::ui(ui, &self.doc, &self.worker, self.rows.2, self.show_timings, note)
+            let note = self
+                .note
+                .as_ref()
+                .filter(|(_, t)| t.elapsed() < Duration::from_secs(10))
+                .map(|(n, _)| n.as_str());
+            status::ui(
+                ui,
+                &self.doc,
+                &self.worker,
+                self.rows.2,
+                self.show_timings,
+                note,
+            )
         });
         let mut asked: Vec<AppCommand> = Vec::new();
         let total = ui.available_rect_before_wrap().width();
@@ -1002,7 +1095,9 @@ impl TracelabApp {
         let epoch = self.widget_epoch;
         let inspector = self.layout.inspector_panel(left).show(ui, |ui| {
             ui.heading("Inspector");
-            ui.push_id(("document", epoch), |ui| asked.extend(inspector::ui(ui, &self.doc)));
+            ui.push_id(("document", epoch), |ui| {
+                asked.extend(inspector::ui(ui, &self.doc))
+            });
         });
         self.layout.shown_inspector(inspector.response.rect.width());
         if self.pixel_inspector_open {
@@ -1032,12 +1127,14 @@ impl TracelabApp {
                             ray_panel::ui(ui, story, &mut self.ray_orbits);
                         });
                 }
-                egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| match &self.story {
-                    Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
-                    None => {
-                        ui.label("Click a pixel in the render view.");
-                    }
-                });
+                egui::ScrollArea::both()
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| match &self.story {
+                        Some((story, scene)) => pixel_inspector::ui(ui, story, scene),
+                        None => {
+                            ui.label("Click a pixel in the render view.");
+                        }
+                    });
             });
         }
         let mut pick = None;
@@ -1053,7 +1150,11 @@ impl TracelabApp {
                         ui.label(f.look[0]);
                         ui.label(f.look[1]);
                     });
-                    if ui.small_button("×").on_hover_text("Hide the caption").clicked() {
+                    if ui
+                        .small_button("×")
+                        .on_hover_text("Hide the caption")
+                        .clicked()
+                    {
                         asked.push(AppCommand::CloseCaption);
                     }
                 });
@@ -1062,11 +1163,17 @@ impl TracelabApp {
             size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
             self.render_size = size;
             self.request_render(size);
-            pick = self.viewport.images(ui, &mut self.view, &self.worker, &self.doc, &mut asked);
+            pick = self
+                .viewport
+                .images(ui, &mut self.view, &self.worker, &self.doc, &mut asked);
         });
         self.commands.extend(asked);
         if let Some(p) = pick {
-            self.queue(AppCommand::Inspect { frame: p.frame, x: p.x, row: p.row });
+            self.queue(AppCommand::Inspect {
+                frame: p.frame,
+                x: p.x,
+                row: p.row,
+            });
         }
         self.dialogs(&ctx);
         self.run_commands(&ctx);

@@ -25,7 +25,9 @@ pub fn world_bounds(scene: &Scene, node: NodeId) -> Option<(Vec3, Vec3)> {
     let mut acc: Option<(Vec3, Vec3)> = None;
     let mut stack = vec![(node, start.as_dmat4())];
     while let Some((id, m)) = stack.pop() {
-        let Some(n) = scene.graph.get(id) else { continue };
+        let Some(n) = scene.graph.get(id) else {
+            continue;
+        };
         let local = match &n.kind {
             NodeKind::Transform(ops) => {
                 let m = m * compose_f64(ops);
@@ -36,16 +38,23 @@ pub fn world_bounds(scene: &Scene, node: NodeId) -> Option<(Vec3, Vec3)> {
                 stack.extend(n.children.iter().map(|&c| (c, m)));
                 continue;
             }
-            NodeKind::Sphere { center, radius } => Some((*center - Vec3::splat(*radius), *center + Vec3::splat(*radius))),
+            NodeKind::Sphere { center, radius } => Some((
+                *center - Vec3::splat(*radius),
+                *center + Vec3::splat(*radius),
+            )),
             NodeKind::Box { min, max } => Some((*min, *max)),
-            NodeKind::Triangle { vertices: [a, b, c] } => Some((a.min(*b).min(*c), a.max(*b).max(*c))),
+            NodeKind::Triangle {
+                vertices: [a, b, c],
+            } => Some((a.min(*b).min(*c), a.max(*b).max(*c))),
             NodeKind::TriangleMesh { mesh, .. } => mesh.mesh().map(|m| {
                 let b = m.bounds();
                 (b.min, b.max)
             }),
             NodeKind::Plane { .. } => None,
         };
-        let Some((lo, hi)) = local.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo.cmple(*hi).all()) else {
+        let Some((lo, hi)) =
+            local.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo.cmple(*hi).all())
+        else {
             continue;
         };
         let m = m.as_mat4();
@@ -85,12 +94,25 @@ mod tests {
         let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
             Group { numObjects 2 Transform { UniformScale 2 Transform { Translate 1 0 0 Sphere { center 0 0 0 radius 0.5 } } } \
             Plane { normal 0 1 0 offset -1 } }\n";
-        let scene = parse_scene(text.as_bytes(), "t", None, &mut MeshCache::new()).scene.expect("parses");
+        let scene = parse_scene(text.as_bytes(), "t", None, &mut MeshCache::new())
+            .scene
+            .expect("parses");
         let root = scene.graph.root();
         let (lo, hi) = world_bounds(&scene, root).expect("bounded");
-        assert!((lo - Vec3::new(1.0, -1.0, -1.0)).length() < 1e-5 && (hi - Vec3::new(3.0, 1.0, 1.0)).length() < 1e-5, "{lo} {hi}");
-        let sphere = scene.graph.preorder().into_iter().find(|&id| matches!(scene.graph.node(id).kind, NodeKind::Sphere { .. })).expect("sphere");
-        assert!((world_centre(&scene, sphere).expect("c") - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5);
+        assert!(
+            (lo - Vec3::new(1.0, -1.0, -1.0)).length() < 1e-5
+                && (hi - Vec3::new(3.0, 1.0, 1.0)).length() < 1e-5,
+            "{lo} {hi}"
+        );
+        let sphere = scene
+            .graph
+            .preorder()
+            .into_iter()
+            .find(|&id| matches!(scene.graph.node(id).kind, NodeKind::Sphere { .. }))
+            .expect("sphere");
+        assert!(
+            (world_centre(&scene, sphere).expect("c") - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5
+        );
         let m = world_from_parent(&scene, sphere).expect("in scene");
         assert!((m.transform_point3(Vec3::ZERO) - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5);
     }

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 
 use tracelab_core::NodeId;
 
+use crate::animation::AnimationForm;
 use crate::document::Selection;
 use crate::document::edit::Edit;
-use crate::animation::AnimationForm;
 use crate::gui::navigation::AxisView;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -18,11 +18,18 @@ pub enum AppCommand {
     /// Change the document (recorded for undo).
     Edit(Edit),
     /// Set a TriangleMesh's file and read it from disk (see `Document::load_mesh`).
-    LoadMesh { node: NodeId, obj_file: String },
+    LoadMesh {
+        node: NodeId,
+        obj_file: String,
+    },
     /// Delete the selected node (the Delete key).
     DeleteSelected,
     /// Trace one pixel of the image on screen for the pixel inspector, and select what it hit.
-    Inspect { frame: usize, x: u32, row: u32 },
+    Inspect {
+        frame: usize,
+        x: u32,
+        row: u32,
+    },
     New,
     /// Ask for a file to open.
     OpenDialog,
@@ -59,14 +66,19 @@ pub enum AppCommand {
     /// Look along an axis, the scene framed (1, 3, 7 as Blender's numpad).
     AxisView(AxisView),
     /// Esc during a drag in the view: back to the state `mark` (see `Document::revert_to`).
-    CancelDrag { mark: u64 },
+    CancelDrag {
+        mark: u64,
+    },
 }
 
 impl AppCommand {
     /// Commands the panels send about what they show: their own widget state stays valid
     /// after them. Any other change to the document gives the panels fresh widget ids.
     pub fn from_panels(&self) -> bool {
-        matches!(self, AppCommand::Select(_) | AppCommand::Edit(_) | AppCommand::LoadMesh { .. })
+        matches!(
+            self,
+            AppCommand::Select(_) | AppCommand::Edit(_) | AppCommand::LoadMesh { .. }
+        )
     }
 }
 

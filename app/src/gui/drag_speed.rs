@@ -24,13 +24,19 @@ impl DragSpeeds {
     }
 
     pub fn for_scene_camera(camera: &Camera) -> Self {
-        DragSpeeds { world_per_point: view_extent(camera) / POINTS_PER_VIEW }
+        DragSpeeds {
+            world_per_point: view_extent(camera) / POINTS_PER_VIEW,
+        }
     }
 
     /// For a length in a space where one unit is `world_per_unit` world units (a Translate,
     /// a centre, a radius, box corners, vertices).
     pub fn length(&self, world_per_unit: f32) -> f64 {
-        let s = if world_per_unit.is_finite() && world_per_unit > 1e-9 { world_per_unit } else { 1.0 };
+        let s = if world_per_unit.is_finite() && world_per_unit > 1e-9 {
+            world_per_unit
+        } else {
+            1.0
+        };
         f64::from(self.world_per_point / s)
     }
 
@@ -45,7 +51,12 @@ impl DragSpeeds {
 fn view_extent(camera: &Camera) -> f32 {
     let extent = match *camera {
         Camera::Orthographic { size, .. } => size,
-        Camera::Perspective { center, direction, angle, .. } => {
+        Camera::Perspective {
+            center,
+            direction,
+            angle,
+            ..
+        } => {
             // How far away the scene is: the origin's depth along the view, or its distance
             // when the camera looks away from it.
             let d = direction.normalize_or_zero();
@@ -54,7 +65,11 @@ fn view_extent(camera: &Camera) -> f32 {
             2.0 * distance.max(1e-3) * (angle.to_radians() * 0.5).tan()
         }
     };
-    if extent.is_finite() && extent > 1e-6 { extent.abs() } else { 10.0 }
+    if extent.is_finite() && extent > 1e-6 {
+        extent.abs()
+    } else {
+        10.0
+    }
 }
 
 /// World units per unit of the space `node`'s parameters live in (all Transforms above it),
@@ -82,7 +97,12 @@ mod tests {
     use super::*;
 
     fn scene(text: &str) -> Scene {
-        let out = tracelab_core::parse_scene(text.as_bytes(), "t.txt", None, &mut tracelab_core::MeshCache::new());
+        let out = tracelab_core::parse_scene(
+            text.as_bytes(),
+            "t.txt",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        );
         out.scene.expect("parses")
     }
 
@@ -95,12 +115,22 @@ mod tests {
         let speeds = DragSpeeds::for_scene(&s);
         let extent = 2.0 * 10.0 * 15f32.to_radians().tan();
         assert!((speeds.length(1.0) - f64::from(extent / POINTS_PER_VIEW)).abs() < 1e-6);
-        let outer = s.graph.iter().find(|(_, n)| matches!(&n.kind, NodeKind::Transform(ops) if ops.len() == 2)).map(|(i, _)| i).expect("outer");
+        let outer = s
+            .graph
+            .iter()
+            .find(|(_, n)| matches!(&n.kind, NodeKind::Transform(ops) if ops.len() == 2))
+            .map(|(i, _)| i)
+            .expect("outer");
         // The Translate comes after UniformScale 5: its units are 5 world units.
         assert!((world_per_unit(&s, outer, Some(1)) - 5.0).abs() < 1e-4);
         assert!((world_per_unit(&s, outer, Some(0)) - 1.0).abs() < 1e-4);
         // The sphere sits under both: 5 · cbrt(1·2·4) = 10.
-        let sphere = s.graph.iter().find(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. })).map(|(i, _)| i).expect("sphere");
+        let sphere = s
+            .graph
+            .iter()
+            .find(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. }))
+            .map(|(i, _)| i)
+            .expect("sphere");
         assert!((world_per_unit(&s, sphere, None) - 10.0).abs() < 1e-3);
         // 60 points of drag move the Translate by a small share of the view, in world units.
         let moved = 60.0 * speeds.length(world_per_unit(&s, outer, Some(1))) * 5.0;
@@ -111,13 +141,29 @@ mod tests {
     fn factors_drag_by_their_own_size_and_degenerate_spaces_fall_back_to_one() {
         assert!((DragSpeeds::factor(100.0) / DragSpeeds::factor(1.0) - 100.0).abs() < 1e-3);
         assert!(DragSpeeds::factor(0.0) > 0.0 && DragSpeeds::factor(f32::NAN) > 0.0);
-        let mut s = scene("OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }
-            Group { numObjects 1 Transform { Scale 1 1 1 Sphere { center 0 0 0 radius 1 } } }");
+        let mut s = scene(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }
+            Group { numObjects 1 Transform { Scale 1 1 1 Sphere { center 0 0 0 radius 1 } } }",
+        );
         // Flattened by an edit (the parser refuses a singular transform, an edit may not yet).
-        let t = s.graph.iter().find(|(_, n)| matches!(n.kind, NodeKind::Transform(_))).map(|(i, _)| i).expect("transform");
-        s.graph.node_mut(t).kind = NodeKind::Transform(vec![tracelab_core::TransformOp::Scale(glam::Vec3::new(1.0, 0.0, 1.0))]);
-        let sphere = s.graph.iter().find(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. })).map(|(i, _)| i).expect("sphere");
+        let t = s
+            .graph
+            .iter()
+            .find(|(_, n)| matches!(n.kind, NodeKind::Transform(_)))
+            .map(|(i, _)| i)
+            .expect("transform");
+        s.graph.node_mut(t).kind = NodeKind::Transform(vec![tracelab_core::TransformOp::Scale(
+            glam::Vec3::new(1.0, 0.0, 1.0),
+        )]);
+        let sphere = s
+            .graph
+            .iter()
+            .find(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. }))
+            .map(|(i, _)| i)
+            .expect("sphere");
         assert_eq!(world_per_unit(&s, sphere, None), 1.0);
-        assert!((DragSpeeds::for_scene(&s).length(1.0) - f64::from(4.0 / POINTS_PER_VIEW)).abs() < 1e-6);
+        assert!(
+            (DragSpeeds::for_scene(&s).length(1.0) - f64::from(4.0 / POINTS_PER_VIEW)).abs() < 1e-6
+        );
     }
 }

@@ -105,7 +105,12 @@ impl FileDialog {
             || Path::new(name)
                 .extension()
                 .and_then(|e| e.to_str())
-                .is_some_and(|e| self.purpose.extensions().iter().any(|x| e.eq_ignore_ascii_case(x)))
+                .is_some_and(|e| {
+                    self.purpose
+                        .extensions()
+                        .iter()
+                        .any(|x| e.eq_ignore_ascii_case(x))
+                })
     }
 
     /// The folder shown.
@@ -191,7 +196,10 @@ impl FileDialog {
                     enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
                 });
                 ui.checkbox(&mut self.all_files, "All files")
-                    .on_hover_text(format!("Off: {} and folders only", self.purpose.filter_name()));
+                    .on_hover_text(format!(
+                        "Off: {} and folders only",
+                        self.purpose.filter_name()
+                    ));
                 ui.horizontal(|ui| {
                     let ok = match self.purpose {
                         Purpose::Open => "Open",

@@ -27,7 +27,12 @@ pub struct FileWatch {
 
 impl Default for FileWatch {
     fn default() -> Self {
-        FileWatch { file: None, watcher: None, changed: Arc::new(AtomicBool::new(false)), last_poll: Instant::now() }
+        FileWatch {
+            file: None,
+            watcher: None,
+            changed: Arc::new(AtomicBool::new(false)),
+            last_poll: Instant::now(),
+        }
     }
 }
 
@@ -81,7 +86,10 @@ fn watch_folder_of(
     let name = file.file_name().map(|n| n.to_os_string());
     let mut w = notify::recommended_watcher(move |ev: notify::Result<notify::Event>| {
         let ours = match &ev {
-            Ok(ev) => ev.paths.iter().any(|p| p.file_name().map(|n| n.to_os_string()) == name),
+            Ok(ev) => ev
+                .paths
+                .iter()
+                .any(|p| p.file_name().map(|n| n.to_os_string()) == name),
             // Events were lost (queue overflow): look at the file to be sure.
             Err(_) => true,
         };
@@ -119,7 +127,10 @@ mod tests {
         let woken = Arc::new(AtomicBool::new(false));
         let w2 = woken.clone();
         let mut w = FileWatch::default();
-        w.follow(Some(&file), Arc::new(move || w2.store(true, Ordering::Relaxed)));
+        w.follow(
+            Some(&file),
+            Arc::new(move || w2.store(true, Ordering::Relaxed)),
+        );
         assert!(w.has_events(), "inotify is available on Linux");
         assert!(!w.take_changed());
         // Another file in the folder: no change reported.

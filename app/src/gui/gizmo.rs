@@ -75,13 +75,23 @@ impl OpSpace {
             None => world_from_parent(scene, node)?,
         };
         let world_from_op = around * tracelab_core::scene::compose(target.before());
-        let value = if target.exists { target.ops.get(target.index)?.clone() } else { kind.identity() };
-        Some(OpSpace { target, world_from_op, value })
+        let value = if target.exists {
+            target.ops.get(target.index)?.clone()
+        } else {
+            kind.identity()
+        };
+        Some(OpSpace {
+            target,
+            world_from_op,
+            value,
+        })
     }
 
     /// Unit world direction of the op space's axis `i`.
     fn axis(&self, i: usize) -> Vec3 {
-        self.world_from_op.transform_vector3(Vec3::AXES[i]).normalize_or(Vec3::AXES[i])
+        self.world_from_op
+            .transform_vector3(Vec3::AXES[i])
+            .normalize_or(Vec3::AXES[i])
     }
 }
 
@@ -125,14 +135,23 @@ impl Gizmo {
     /// origin's depth, about its z axis.
     fn ring(&self) -> Vec<Vec3> {
         let s = &self.rotate.world_from_op;
-        let Some(inv) = invert(s) else { return Vec::new() };
+        let Some(inv) = invert(s) else {
+            return Vec::new();
+        };
         let o = inv.transform_point3(self.origin);
         let centre = Vec3::new(0.0, 0.0, o.z);
-        let (ex, ey) = (s.transform_vector3(Vec3::X).length(), s.transform_vector3(Vec3::Y).length());
+        let (ex, ey) = (
+            s.transform_vector3(Vec3::X).length(),
+            s.transform_vector3(Vec3::Y).length(),
+        );
         let r = RING * self.arm / ex.max(ey).max(1e-9);
         // Around the rotation's centre when the object sits on its axis; else around the
         // object, with the same orientation, so it stays where the eye is.
-        let at = if (o - centre).truncate().length() < r * 0.5 { centre } else { o };
+        let at = if (o - centre).truncate().length() < r * 0.5 {
+            centre
+        } else {
+            o
+        };
         (0..=48)
             .map(|k| {
                 let a = k as f32 / 48.0 * std::f32::consts::TAU;
@@ -161,15 +180,25 @@ impl Gizmo {
         let o = self.origin;
         for i in 0..3 {
             let a = self.move_axis(i);
-            if let (Some(p0), Some(p1)) = (view.project(o + a * self.arm * SHAFT_FROM), view.project(o + a * self.arm)) {
-                consider(segment_distance(pos, p0, p1 + (p1 - p0) * 0.3), Handle::Move(i));
+            if let (Some(p0), Some(p1)) = (
+                view.project(o + a * self.arm * SHAFT_FROM),
+                view.project(o + a * self.arm),
+            ) {
+                consider(
+                    segment_distance(pos, p0, p1 + (p1 - p0) * 0.3),
+                    Handle::Move(i),
+                );
             }
             if let Some(c) = view.project(o + self.scale.axis(i) * self.arm * SQUARE_AT) {
                 // The squares win over a shaft they overlap.
                 consider((pos - c).length() * 0.8, Handle::Scale(i));
             }
         }
-        let ring: Vec<egui::Pos2> = self.ring().into_iter().filter_map(|p| view.project(p)).collect();
+        let ring: Vec<egui::Pos2> = self
+            .ring()
+            .into_iter()
+            .filter_map(|p| view.project(p))
+            .collect();
         for w in ring.windows(2) {
             consider(segment_distance(pos, w[0], w[1]), Handle::Rotate);
         }
@@ -182,29 +211,52 @@ impl Gizmo {
             if hot == Some(h) {
                 egui::Color32::from_rgb(255, 230, 60)
             } else {
-                [egui::Color32::from_rgb(230, 60, 60), egui::Color32::from_rgb(80, 200, 80), egui::Color32::from_rgb(70, 120, 255)][i]
+                [
+                    egui::Color32::from_rgb(230, 60, 60),
+                    egui::Color32::from_rgb(80, 200, 80),
+                    egui::Color32::from_rgb(70, 120, 255),
+                ][i]
             }
         };
         let o = self.origin;
         let Some(c) = view.project(o) else { return };
-        let ring: Vec<egui::Pos2> = self.ring().into_iter().filter_map(|p| view.project(p)).collect();
-        let ring_colour = if hot == Some(Handle::Rotate) { egui::Color32::from_rgb(255, 230, 60) } else { egui::Color32::from_rgb(90, 210, 230) };
+        let ring: Vec<egui::Pos2> = self
+            .ring()
+            .into_iter()
+            .filter_map(|p| view.project(p))
+            .collect();
+        let ring_colour = if hot == Some(Handle::Rotate) {
+            egui::Color32::from_rgb(255, 230, 60)
+        } else {
+            egui::Color32::from_rgb(90, 210, 230)
+        };
         painter.add(egui::Shape::line(ring, egui::Stroke::new(2.0, ring_colour)));
         for i in 0..3 {
             let a = self.move_axis(i);
-            if let (Some(p0), Some(p1)) = (view.project(o + a * self.arm * SHAFT_FROM), view.project(o + a * self.arm)) {
+            if let (Some(p0), Some(p1)) = (
+                view.project(o + a * self.arm * SHAFT_FROM),
+                view.project(o + a * self.arm),
+            ) {
                 let col = colour(i, Handle::Move(i));
                 painter.line_segment([p0, p1], egui::Stroke::new(2.5, col));
                 let d = (p1 - p0).normalized();
                 if d.is_finite() && (p1 - p0).length() > 4.0 {
                     let n = egui::vec2(-d.y, d.x);
                     let tip = p1 + d * 12.0;
-                    painter.add(egui::Shape::convex_polygon(vec![tip, p1 + n * 5.0, p1 - n * 5.0], col, egui::Stroke::NONE));
+                    painter.add(egui::Shape::convex_polygon(
+                        vec![tip, p1 + n * 5.0, p1 - n * 5.0],
+                        col,
+                        egui::Stroke::NONE,
+                    ));
                 }
             }
             if let Some(q) = view.project(o + self.scale.axis(i) * self.arm * SQUARE_AT) {
                 let col = colour(i, Handle::Scale(i));
-                painter.rect_filled(egui::Rect::from_center_size(q, egui::vec2(8.0, 8.0)), 1.0, col);
+                painter.rect_filled(
+                    egui::Rect::from_center_size(q, egui::vec2(8.0, 8.0)),
+                    1.0,
+                    col,
+                );
                 painter.line_segment([c, q], egui::Stroke::new(1.0, col.gamma_multiply(0.6)));
             }
         }
@@ -242,7 +294,12 @@ impl Gizmo {
             world_from_op: space.world_from_op,
             start: space.value.clone(),
             grabbed: along,
-            arm_in_op: self.arm / space.world_from_op.transform_vector3(Vec3::X).length().max(1e-9),
+            arm_in_op: self.arm
+                / space
+                    .world_from_op
+                    .transform_vector3(Vec3::X)
+                    .length()
+                    .max(1e-9),
             last_angle: along,
             turned: 0.0,
             target: space.target.clone(),
@@ -310,7 +367,11 @@ impl GizmoDrag {
                 s[i] = s0[i] * f.max(0.01);
                 if snap {
                     let snapped = (s[i] / SNAP_FACTOR).round() * SNAP_FACTOR;
-                    s[i] = if snapped.abs() < SNAP_FACTOR { SNAP_FACTOR.copysign(s0[i]) } else { snapped };
+                    s[i] = if snapped.abs() < SNAP_FACTOR {
+                        SNAP_FACTOR.copysign(s0[i])
+                    } else {
+                        snapped
+                    };
                 }
                 TransformOp::Scale(s)
             }
@@ -379,11 +440,17 @@ mod tests {
     use tracelab_core::{MeshCache, NodeKind, parse_scene};
 
     fn scene(text: &str) -> Scene {
-        parse_scene(text.as_bytes(), "t", None, &mut MeshCache::new()).scene.expect("parses")
+        parse_scene(text.as_bytes(), "t", None, &mut MeshCache::new())
+            .scene
+            .expect("parses")
     }
 
     fn sphere(s: &Scene) -> NodeId {
-        s.graph.preorder().into_iter().find(|&id| matches!(s.graph.node(id).kind, NodeKind::Sphere { .. })).expect("sphere")
+        s.graph
+            .preorder()
+            .into_iter()
+            .find(|&id| matches!(s.graph.node(id).kind, NodeKind::Sphere { .. }))
+            .expect("sphere")
     }
 
     const SCALED: &str = "PerspectiveCamera { center 1 2 12 direction -0.1 -0.15 -1 up 0 1 0 angle 30 }\n\
@@ -393,7 +460,12 @@ mod tests {
     fn a_translate_drag_keeps_the_grabbed_point_under_the_pointer_whatever_the_scales() {
         let s = scene(SCALED);
         let node = sphere(&s);
-        let view = OnScreen::new(&s.camera, 400, 400, egui::Rect::from_min_size(egui::pos2(10.0, 20.0), egui::vec2(400.0, 400.0)));
+        let view = OnScreen::new(
+            &s.camera,
+            400,
+            400,
+            egui::Rect::from_min_size(egui::pos2(10.0, 20.0), egui::vec2(400.0, 400.0)),
+        );
         for axes in [Axes::World, Axes::Local] {
             let g = Gizmo::new(&s, node, &view, axes).expect("gizmo");
             for i in 0..3 {
@@ -405,29 +477,54 @@ mod tests {
                 let to = view.project(to_world).expect("visible");
                 let op = drag.value(&view, to, false).expect("follows");
                 let mut moved = s.clone();
-                crate::document::edit::apply_to(&mut moved, crate::document::edit::Edit::SetOpOfKind { node, op }).expect("applies");
+                crate::document::edit::apply_to(
+                    &mut moved,
+                    crate::document::edit::Edit::SetOpOfKind { node, op },
+                )
+                .expect("applies");
                 let c = world_centre(&moved, node).expect("centre");
-                assert!((c - (g.origin + a * 0.3)).length() < 1e-3, "{axes:?} axis {i}: {c} vs {}", g.origin + a * 0.3);
+                assert!(
+                    (c - (g.origin + a * 0.3)).length() < 1e-3,
+                    "{axes:?} axis {i}: {c} vs {}",
+                    g.origin + a * 0.3
+                );
             }
         }
     }
 
     #[test]
     fn a_ring_drag_turns_the_grabbed_point_to_the_pointer_and_snaps_to_15_degrees() {
-        let s = scene("OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 6 }\n\
-            Group { numObjects 1 Transform { Translate 1 0 0 Sphere { center 0 0 0 radius 0.5 } } }\n");
+        let s = scene(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 6 }\n\
+            Group { numObjects 1 Transform { Translate 1 0 0 Sphere { center 0 0 0 radius 0.5 } } }\n",
+        );
         let node = sphere(&s);
-        let view = OnScreen::new(&s.camera, 300, 300, egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(300.0, 300.0)));
+        let view = OnScreen::new(
+            &s.camera,
+            300,
+            300,
+            egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(300.0, 300.0)),
+        );
         let g = Gizmo::new(&s, node, &view, Axes::World).expect("gizmo");
         let ring = g.ring();
         let grab = view.project(ring[0]).expect("on screen");
         assert_eq!(g.pick(&view, grab), Some(Handle::Rotate));
         let mut drag = g.grab(&view, Handle::Rotate, grab).expect("grabbed");
-        assert!(!drag.target.exists && drag.target.index == 1, "{:?}", drag.target);
+        assert!(
+            !drag.target.exists && drag.target.index == 1,
+            "{:?}",
+            drag.target
+        );
         let to = view.project(ring[8]).expect("on screen"); // 60° on
-        let Some(TransformOp::ZRotate(d)) = drag.value(&view, to, false) else { panic!("a ZRotate") };
+        let Some(TransformOp::ZRotate(d)) = drag.value(&view, to, false) else {
+            panic!("a ZRotate")
+        };
         assert!((d - 60.0).abs() < 0.5, "{d}");
-        let Some(TransformOp::ZRotate(d)) = drag.value(&view, view.project(ring[10]).expect("on"), true) else { panic!("a ZRotate") };
+        let Some(TransformOp::ZRotate(d)) =
+            drag.value(&view, view.project(ring[10]).expect("on"), true)
+        else {
+            panic!("a ZRotate")
+        };
         assert_eq!(d, 75.0);
     }
 }

@@ -27,7 +27,11 @@ impl Layout {
     /// The panel id: the plain name at first, so sizes remembered by earlier versions are
     /// found (and clamped); a new name after each reset.
     fn id(&self, name: &str) -> String {
-        if self.epoch == 0 { name.to_string() } else { format!("{name}#{}", self.epoch) }
+        if self.epoch == 0 {
+            name.to_string()
+        } else {
+            format!("{name}#{}", self.epoch)
+        }
     }
 
     /// The id of a panel nested in one of these (the Ray panel in the dock).
@@ -37,7 +41,11 @@ impl Layout {
 
     /// The scene tree, left, in a window `total` points wide.
     pub fn tree_panel(&self, total: f32) -> egui::Panel {
-        let inspector = if self.inspector > 0.0 { self.inspector } else { INSPECTOR_WIDTH };
+        let inspector = if self.inspector > 0.0 {
+            self.inspector
+        } else {
+            INSPECTOR_WIDTH
+        };
         egui::Panel::left(self.id("tree"))
             .resizable(true)
             .default_size(TREE_WIDTH)
@@ -70,7 +78,10 @@ impl Layout {
 
     /// View › Reset layout.
     pub fn reset(&mut self) {
-        *self = Layout { epoch: self.epoch + 1, ..Layout::default() };
+        *self = Layout {
+            epoch: self.epoch + 1,
+            ..Layout::default()
+        };
     }
 }
 
@@ -85,6 +96,12 @@ mod tests {
         l.shown_tree(900.0);
         l.reset();
         assert_eq!(l.id("tree"), "tree#1");
-        assert_eq!(l, Layout { epoch: 1, ..Layout::default() });
+        assert_eq!(
+            l,
+            Layout {
+                epoch: 1,
+                ..Layout::default()
+            }
+        );
     }
 }

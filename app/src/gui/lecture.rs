@@ -36,29 +36,147 @@ const fn fig(file: &'static str, caption: &'static str, look: [&'static str; 2])
 }
 
 pub static FIGURES: &[Figure] = &[
-    fig("simple_scene.txt", "A simple scene description", ["Camera, one light, background, three materials, four spheres.", "Open the tree: every part of the file is a node."]),
-    fig("class_hierarchy.txt", "The class hierarchy", ["Materials set at three levels of Groups land where the slide says.", "Select a Group to see what its children inherit."]),
-    fig("class_hierarchy_transforms.txt", "The class hierarchy with transforms", ["The blue cross turned by ZRotate 45, the brown group moved left.", "Drag the ops in the inspector: the whole subtree follows."]),
-    fig("nested_transforms.txt", "Nested transforms", ["Each Transform applies to everything inside it: the first op listed is applied last.", "flat_transforms.txt lists the same ops in one Transform: the same image."]),
-    fig("flat_transforms.txt", "Nested transforms, flattened", ["One Transform per object with the chain's ops in order.", "The same image as the nested version, pixel for pixel."]),
-    Figure { tab: Tab::Normals, ..fig("normals.txt", "Normal visualisation", ["|n_x| |n_y| |n_z| as RGB: the floor is pure green (n = +y).", "A face's colour says which way it points."]) },
-    Figure { compare: Compare::Split, ..fig("normal_transform.txt", "Incorrect vs correct normal transformation", ["Left of the yellow line (M^-1)^T·n, right M·n: on the right the shading slides off the sheared shapes.", "Click a pixel: the Ray panel draws both normals; the toolbar gives their largest angle."]) },
-    fig("shading_light_only.txt", "Diffuse shading, light only", ["c = max(L·N, 0)·c_light·k_d with no ambient: the unlit sides are black.", "Click a pixel: the terms of the sum are listed."]),
-    fig("shading_half_ambient.txt", "Diffuse shading with ambient", ["c_light = c_ambient = 0.5: the unlit sides show half the colour.", "Nothing is brighter than k_d itself."]),
-    fig("perspective.txt", "A perspective camera", ["Equal spheres shrink with distance; the floor recedes to a horizon.", "Click near and far spheres: the world rays fan out from the eye."]),
-    fig("cube_mesh.txt", "A triangle mesh", ["The cube from an OBJ file, 12 triangles, flat-shaded faces.", "No cracks along the triangles' shared edges."]),
-    fig("csg_union.txt", "CSG: union", ["A or B: each part keeps its sphere's material.", "Click where they meet: the story names the operand hit."]),
-    fig("csg_intersection.txt", "CSG: intersection", ["A and B: the lens both spheres share.", "Its faces come from both spheres."]),
-    Figure { tab: Tab::All, ..fig("csg_subtraction.txt", "CSG: subtraction", ["A minus B: the bite is B's surface, its normals turned toward the viewer.", "Compare the colour and normal images of the bite."]) },
-    fig("csg_die.txt", "A CSG die", ["A rounded cube (cube and sphere) minus six spheres for the pips.", "Select an operand in the tree and drag it: the pits move."]),
+    fig(
+        "simple_scene.txt",
+        "A simple scene description",
+        [
+            "Camera, one light, background, three materials, four spheres.",
+            "Open the tree: every part of the file is a node.",
+        ],
+    ),
+    fig(
+        "class_hierarchy.txt",
+        "The class hierarchy",
+        [
+            "Materials set at three levels of Groups land where the slide says.",
+            "Select a Group to see what its children inherit.",
+        ],
+    ),
+    fig(
+        "class_hierarchy_transforms.txt",
+        "The class hierarchy with transforms",
+        [
+            "The blue cross turned by ZRotate 45, the brown group moved left.",
+            "Drag the ops in the inspector: the whole subtree follows.",
+        ],
+    ),
+    fig(
+        "nested_transforms.txt",
+        "Nested transforms",
+        [
+            "Each Transform applies to everything inside it: the first op listed is applied last.",
+            "flat_transforms.txt lists the same ops in one Transform: the same image.",
+        ],
+    ),
+    fig(
+        "flat_transforms.txt",
+        "Nested transforms, flattened",
+        [
+            "One Transform per object with the chain's ops in order.",
+            "The same image as the nested version, pixel for pixel.",
+        ],
+    ),
+    Figure {
+        tab: Tab::Normals,
+        ..fig(
+            "normals.txt",
+            "Normal visualisation",
+            [
+                "|n_x| |n_y| |n_z| as RGB: the floor is pure green (n = +y).",
+                "A face's colour says which way it points.",
+            ],
+        )
+    },
+    Figure {
+        compare: Compare::Split,
+        ..fig(
+            "normal_transform.txt",
+            "Incorrect vs correct normal transformation",
+            [
+                "Left of the yellow line (M^-1)^T·n, right M·n: on the right the shading slides off the sheared shapes.",
+                "Click a pixel: the Ray panel draws both normals; the toolbar gives their largest angle.",
+            ],
+        )
+    },
+    fig(
+        "shading_light_only.txt",
+        "Diffuse shading, light only",
+        [
+            "c = max(L·N, 0)·c_light·k_d with no ambient: the unlit sides are black.",
+            "Click a pixel: the terms of the sum are listed.",
+        ],
+    ),
+    fig(
+        "shading_half_ambient.txt",
+        "Diffuse shading with ambient",
+        [
+            "c_light = c_ambient = 0.5: the unlit sides show half the colour.",
+            "Nothing is brighter than k_d itself.",
+        ],
+    ),
+    fig(
+        "perspective.txt",
+        "A perspective camera",
+        [
+            "Equal spheres shrink with distance; the floor recedes to a horizon.",
+            "Click near and far spheres: the world rays fan out from the eye.",
+        ],
+    ),
+    fig(
+        "cube_mesh.txt",
+        "A triangle mesh",
+        [
+            "The cube from an OBJ file, 12 triangles, flat-shaded faces.",
+            "No cracks along the triangles' shared edges.",
+        ],
+    ),
+    fig(
+        "csg_union.txt",
+        "CSG: union",
+        [
+            "A or B: each part keeps its sphere's material.",
+            "Click where they meet: the story names the operand hit.",
+        ],
+    ),
+    fig(
+        "csg_intersection.txt",
+        "CSG: intersection",
+        [
+            "A and B: the lens both spheres share.",
+            "Its faces come from both spheres.",
+        ],
+    ),
+    Figure {
+        tab: Tab::All,
+        ..fig(
+            "csg_subtraction.txt",
+            "CSG: subtraction",
+            [
+                "A minus B: the bite is B's surface, its normals turned toward the viewer.",
+                "Compare the colour and normal images of the bite.",
+            ],
+        )
+    },
+    fig(
+        "csg_die.txt",
+        "A CSG die",
+        [
+            "A rounded cube (cube and sphere) minus six spheres for the pips.",
+            "Select an operand in the tree and drag it: the pits move.",
+        ],
+    ),
     Figure {
         object_rays: ObjectRays::NormalizedNoRescale,
         tab: Tab::All,
         depth: Some((2.0, 18.0)),
-        ..fig("depth_t.txt", "What to do about the depth t", [
-            "Shown with the classic bug: M^-1 d normalised and t not rescaled, so the big blue sphere jumps in front.",
-            "Switch 'depth t' to unnormalised or normalised (t rescaled): the small red sphere is in front again.",
-        ])
+        ..fig(
+            "depth_t.txt",
+            "What to do about the depth t",
+            [
+                "Shown with the classic bug: M^-1 d normalised and t not rescaled, so the big blue sphere jumps in front.",
+                "Switch 'depth t' to unnormalised or normalised (t rescaled): the small red sphere is in front again.",
+            ],
+        )
     },
 ];
 

@@ -54,15 +54,24 @@ pub struct Loading {
 impl Loading {
     /// Starts reading `path` on a new thread with `cache` (a copy of the document's: the
     /// original stays in use meanwhile). `repaint` is called whenever there is news.
-    pub fn start(path: &Path, purpose: LoadPurpose, mut cache: MeshCache, repaint: Arc<dyn Fn() + Send + Sync>) -> Loading {
+    pub fn start(
+        path: &Path,
+        purpose: LoadPurpose,
+        mut cache: MeshCache,
+        repaint: Arc<dyn Fn() + Send + Sync>,
+    ) -> Loading {
         let progress = Arc::new(Mutex::new(Progress::default()));
         let cancel = Arc::new(AtomicBool::new(false));
         let (p, c, r) = (progress.clone(), cancel.clone(), repaint.clone());
         cache.set_observer(Some(Arc::new(move |e: MeshEvent<'_>| {
             let mut g = p.lock().unwrap_or_else(PoisonError::into_inner);
             match e {
-                MeshEvent::Reading { path, bytes } => g.current = Some((path.to_path_buf(), Step::Reading { bytes })),
-                MeshEvent::Parsing { path } => g.current = Some((path.to_path_buf(), Step::Parsing)),
+                MeshEvent::Reading { path, bytes } => {
+                    g.current = Some((path.to_path_buf(), Step::Reading { bytes }))
+                }
+                MeshEvent::Parsing { path } => {
+                    g.current = Some((path.to_path_buf(), Step::Parsing))
+                }
                 MeshEvent::Building { path, triangles } => {
                     g.current = Some((path.to_path_buf(), Step::Building { triangles }));
                 }
@@ -77,13 +86,15 @@ impl Loading {
         })));
         let (tx, rx) = channel();
         let file = path.to_path_buf();
-        let spawned = std::thread::Builder::new().name("tracelab-open".into()).spawn(move || {
-            let mut read = read_scene_file(&file, cache);
-            read.cache.set_observer(None);
-            // After a cancel nobody listens: the result is dropped here.
-            let _ = tx.send(read);
-            repaint();
-        });
+        let spawned = std::thread::Builder::new()
+            .name("tracelab-open".into())
+            .spawn(move || {
+                let mut read = read_scene_file(&file, cache);
+                read.cache.set_observer(None);
+                // After a cancel nobody listens: the result is dropped here.
+                let _ = tx.send(read);
+                repaint();
+            });
         let rx = match spawned {
             Ok(_) => rx,
             Err(e) => {
@@ -91,13 +102,23 @@ impl Loading {
                 let (tx, rx) = channel();
                 let _ = tx.send(SceneRead {
                     path: path.to_path_buf(),
-                    outcome: Err(vec![format!("{}: cannot start reading: {e}", path.display())]),
+                    outcome: Err(vec![format!(
+                        "{}: cannot start reading: {e}",
+                        path.display()
+                    )]),
                     cache: MeshCache::new(),
                 });
                 rx
             }
         };
-        Loading { path: path.to_path_buf(), purpose, started: Instant::now(), progress, cancel, rx }
+        Loading {
+            path: path.to_path_buf(),
+            purpose,
+            started: Instant::now(),
+            progress,
+            cancel,
+            rx,
+        }
     }
 
     /// The result, once the thread is done.
@@ -107,7 +128,10 @@ impl Loading {
             Err(TryRecvError::Empty) => None,
             Err(TryRecvError::Disconnected) => Some(SceneRead {
                 path: self.path.clone(),
-                outcome: Err(vec![format!("{}: reading stopped unexpectedly", self.path.display())]),
+                outcome: Err(vec![format!(
+                    "{}: reading stopped unexpectedly",
+                    self.path.display()
+                )]),
                 cache: MeshCache::new(),
             }),
         }
@@ -119,7 +143,10 @@ impl Loading {
     }
 
     pub fn progress(&self) -> Progress {
-        self.progress.lock().unwrap_or_else(PoisonError::into_inner).clone()
+        self.progress
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
     }
 
     pub fn elapsed(&self) -> Duration {
@@ -137,18 +164,33 @@ impl Loading {
             Some(Step::Building { .. }) => 0.6,
         };
         let total = p.meshes_done + usize::from(p.current.is_some());
-        if total == 0 { 0.0 } else { (p.meshes_done as f32 + step) / total as f32 }
+        if total == 0 {
+            0.0
+        } else {
+            (p.meshes_done as f32 + step) / total as f32
+        }
     }
 
     /// One line: what is being read, and for how long.
     pub fn describe(&self) -> String {
         let p = self.progress();
-        let name = |p: &Path| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().to_string());
+        let name = |p: &Path| {
+            p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().to_string(),
+            )
+        };
         let what = match &p.current {
-            Some((mesh, Step::Reading { bytes })) => format!("reading {} ({:.1} MB)", name(mesh), *bytes as f64 / 1e6),
+            Some((mesh, Step::Reading { bytes })) => {
+                format!("reading {} ({:.1} MB)", name(mesh), *bytes as f64 / 1e6)
+            }
             Some((mesh, Step::Parsing)) => format!("parsing {}", name(mesh)),
             Some((mesh, Step::Building { triangles })) => {
-                format!("building the BVH of {} ({} triangles)", name(mesh), thousands(*triangles))
+                format!(
+                    "building the BVH of {} ({} triangles)",
+                    name(mesh),
+                    thousands(*triangles)
+                )
             }
             None if p.meshes_done > 0 => format!("{} mesh(es) read, finishing", p.meshes_done),
             None => "reading the scene".to_string(),
@@ -157,7 +199,11 @@ impl Loading {
             LoadPurpose::Open => "Opening",
             LoadPurpose::Reload | LoadPurpose::Refresh => "Reloading",
         };
-        format!("{verb} {}: {what} · {:.1} s", name(&self.path), self.elapsed().as_secs_f64())
+        format!(
+            "{verb} {}: {what} · {:.1} s",
+            name(&self.path),
+            self.elapsed().as_secs_f64()
+        )
     }
 }
 
@@ -205,7 +251,12 @@ mod tests {
         .expect("write");
         let news = Arc::new(Mutex::new(0usize));
         let n = news.clone();
-        let l = Loading::start(&scene, LoadPurpose::Open, MeshCache::new(), Arc::new(move || *n.lock().expect("lock") += 1));
+        let l = Loading::start(
+            &scene,
+            LoadPurpose::Open,
+            MeshCache::new(),
+            Arc::new(move || *n.lock().expect("lock") += 1),
+        );
         let read = wait(&l);
         assert!(read.outcome.is_ok());
         assert_eq!(l.progress().meshes_done, 1);
@@ -226,11 +277,23 @@ mod tests {
 
     #[test]
     fn a_file_that_is_not_there_fails_as_a_message() {
-        let l = Loading::start(Path::new("/nonexistent/scene.txt"), LoadPurpose::Open, MeshCache::new(), Arc::new(|| {}));
+        let l = Loading::start(
+            Path::new("/nonexistent/scene.txt"),
+            LoadPurpose::Open,
+            MeshCache::new(),
+            Arc::new(|| {}),
+        );
         let read = wait(&l);
         let e = read.outcome.err().expect("an error");
-        assert!(e.iter().any(|m| m.contains("/nonexistent/scene.txt")), "{e:?}");
-        assert!(l.describe().starts_with("Opening scene.txt: "), "{}", l.describe());
+        assert!(
+            e.iter().any(|m| m.contains("/nonexistent/scene.txt")),
+            "{e:?}"
+        );
+        assert!(
+            l.describe().starts_with("Opening scene.txt: "),
+            "{}",
+            l.describe()
+        );
     }
 
     #[test]

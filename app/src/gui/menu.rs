@@ -25,28 +25,108 @@ const CMD_SHIFT: Modifiers = Modifiers::COMMAND.plus(Modifiers::SHIFT);
 /// Every menu entry and shortcut. `Modifiers::NONE` keys (Delete) count only while no text
 /// field has the keyboard.
 pub static ENTRIES: &[Entry] = &[
-    Entry { command: AppCommand::New, label: "New", keys: &[keys(CMD, Key::N)], keys_text: "Ctrl+N" },
-    Entry { command: AppCommand::OpenDialog, label: "Open…", keys: &[keys(CMD, Key::O)], keys_text: "Ctrl+O" },
-    Entry { command: AppCommand::Save, label: "Save", keys: &[keys(CMD, Key::S)], keys_text: "Ctrl+S" },
-    Entry { command: AppCommand::SaveAsDialog, label: "Save As…", keys: &[keys(CMD_SHIFT, Key::S)], keys_text: "Ctrl+Shift+S" },
-    Entry { command: AppCommand::Reload, label: "Reload from disk", keys: &[], keys_text: "" },
-    Entry { command: AppCommand::ExportDialog, label: "Export view…", keys: &[], keys_text: "" },
-    Entry { command: AppCommand::AnimationDialog, label: "Export animation…", keys: &[], keys_text: "" },
-    Entry { command: AppCommand::Quit, label: "Quit", keys: &[keys(CMD, Key::Q)], keys_text: "Ctrl+Q" },
-    Entry { command: AppCommand::Undo, label: "Undo", keys: &[keys(CMD, Key::Z)], keys_text: "Ctrl+Z" },
+    Entry {
+        command: AppCommand::New,
+        label: "New",
+        keys: &[keys(CMD, Key::N)],
+        keys_text: "Ctrl+N",
+    },
+    Entry {
+        command: AppCommand::OpenDialog,
+        label: "Open…",
+        keys: &[keys(CMD, Key::O)],
+        keys_text: "Ctrl+O",
+    },
+    Entry {
+        command: AppCommand::Save,
+        label: "Save",
+        keys: &[keys(CMD, Key::S)],
+        keys_text: "Ctrl+S",
+    },
+    Entry {
+        command: AppCommand::SaveAsDialog,
+        label: "Save As…",
+        keys: &[keys(CMD_SHIFT, Key::S)],
+        keys_text: "Ctrl+Shift+S",
+    },
+    Entry {
+        command: AppCommand::Reload,
+        label: "Reload from disk",
+        keys: &[],
+        keys_text: "",
+    },
+    Entry {
+        command: AppCommand::ExportDialog,
+        label: "Export view…",
+        keys: &[],
+        keys_text: "",
+    },
+    Entry {
+        command: AppCommand::AnimationDialog,
+        label: "Export animation…",
+        keys: &[],
+        keys_text: "",
+    },
+    Entry {
+        command: AppCommand::Quit,
+        label: "Quit",
+        keys: &[keys(CMD, Key::Q)],
+        keys_text: "Ctrl+Q",
+    },
+    Entry {
+        command: AppCommand::Undo,
+        label: "Undo",
+        keys: &[keys(CMD, Key::Z)],
+        keys_text: "Ctrl+Z",
+    },
     Entry {
         command: AppCommand::Redo,
         label: "Redo",
         keys: &[keys(CMD_SHIFT, Key::Z), keys(CMD, Key::Y)],
         keys_text: "Ctrl+Shift+Z",
     },
-    Entry { command: AppCommand::ResetLayout, label: "Reset layout", keys: &[], keys_text: "" },
-    Entry { command: AppCommand::DeleteSelected, label: "Delete", keys: &[keys(Modifiers::NONE, Key::Delete)], keys_text: "Del" },
-    Entry { command: AppCommand::FrameSelected, label: "Frame selected", keys: &[keys(Modifiers::NONE, Key::F)], keys_text: "F" },
-    Entry { command: AppCommand::FrameAll, label: "Frame all", keys: &[keys(Modifiers::NONE, Key::Home)], keys_text: "Home" },
-    Entry { command: AppCommand::AxisView(AxisView::Front), label: "Front view", keys: &[keys(Modifiers::NONE, Key::Num1)], keys_text: "1" },
-    Entry { command: AppCommand::AxisView(AxisView::Right), label: "Side view (right)", keys: &[keys(Modifiers::NONE, Key::Num3)], keys_text: "3" },
-    Entry { command: AppCommand::AxisView(AxisView::Top), label: "Top view", keys: &[keys(Modifiers::NONE, Key::Num7)], keys_text: "7" },
+    Entry {
+        command: AppCommand::ResetLayout,
+        label: "Reset layout",
+        keys: &[],
+        keys_text: "",
+    },
+    Entry {
+        command: AppCommand::DeleteSelected,
+        label: "Delete",
+        keys: &[keys(Modifiers::NONE, Key::Delete)],
+        keys_text: "Del",
+    },
+    Entry {
+        command: AppCommand::FrameSelected,
+        label: "Frame selected",
+        keys: &[keys(Modifiers::NONE, Key::F)],
+        keys_text: "F",
+    },
+    Entry {
+        command: AppCommand::FrameAll,
+        label: "Frame all",
+        keys: &[keys(Modifiers::NONE, Key::Home)],
+        keys_text: "Home",
+    },
+    Entry {
+        command: AppCommand::AxisView(AxisView::Front),
+        label: "Front view",
+        keys: &[keys(Modifiers::NONE, Key::Num1)],
+        keys_text: "1",
+    },
+    Entry {
+        command: AppCommand::AxisView(AxisView::Right),
+        label: "Side view (right)",
+        keys: &[keys(Modifiers::NONE, Key::Num3)],
+        keys_text: "3",
+    },
+    Entry {
+        command: AppCommand::AxisView(AxisView::Top),
+        label: "Top view",
+        keys: &[keys(Modifiers::NONE, Key::Num7)],
+        keys_text: "7",
+    },
 ];
 
 /// The table's entry for a command.
@@ -64,7 +144,12 @@ pub fn menu_text(command: &AppCommand) -> String {
 }
 
 /// A menu button for a command; queues it when clicked.
-pub fn button(ui: &mut egui::Ui, enabled: bool, command: AppCommand, out: &mut Vec<AppCommand>) -> egui::Response {
+pub fn button(
+    ui: &mut egui::Ui,
+    enabled: bool,
+    command: AppCommand,
+    out: &mut Vec<AppCommand>,
+) -> egui::Response {
     let r = ui.add_enabled(enabled, egui::Button::new(menu_text(&command)));
     if r.clicked() {
         out.push(command);
@@ -75,8 +160,10 @@ pub fn button(ui: &mut egui::Ui, enabled: bool, command: AppCommand, out: &mut V
 /// The commands whose keys were pressed this frame. Shortcuts with more modifiers are tried
 /// first, so Ctrl+Shift+Z does not also count as Ctrl+Z.
 pub fn shortcuts(ctx: &egui::Context) -> Vec<AppCommand> {
-    let mut all: Vec<(&KeyboardShortcut, &AppCommand)> =
-        ENTRIES.iter().flat_map(|e| e.keys.iter().map(move |k| (k, &e.command))).collect();
+    let mut all: Vec<(&KeyboardShortcut, &AppCommand)> = ENTRIES
+        .iter()
+        .flat_map(|e| e.keys.iter().map(move |k| (k, &e.command)))
+        .collect();
     all.sort_by_key(|(k, _)| std::cmp::Reverse(modifier_count(k.modifiers)));
     let mut out: Vec<AppCommand> = Vec::new();
     for (k, command) in all {
@@ -110,7 +197,10 @@ mod tests {
             }
             assert_eq!(e.keys.is_empty(), e.keys_text.is_empty(), "{}", e.label);
         }
-        assert_eq!(menu_text(&AppCommand::SaveAsDialog), "Save As… (Ctrl+Shift+S)");
+        assert_eq!(
+            menu_text(&AppCommand::SaveAsDialog),
+            "Save As… (Ctrl+Shift+S)"
+        );
         assert_eq!(menu_text(&AppCommand::Reload), "Reload from disk");
     }
 }

@@ -32,11 +32,17 @@ pub enum Answer {
 impl NativeDialog {
     /// Whether this build has native dialogs and the session looks like it can show one.
     pub fn available() -> bool {
-        cfg!(feature = "native-dialogs") && (cfg!(not(target_os = "linux")) || std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some())
+        cfg!(feature = "native-dialogs")
+            && (cfg!(not(target_os = "linux"))
+                || std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some())
     }
 
     /// Opens one, or `None` when this build or desktop has none.
-    pub fn start(purpose: Purpose, start: Option<&Path>, repaint: std::sync::Arc<dyn Fn() + Send + Sync>) -> Option<NativeDialog> {
+    pub fn start(
+        purpose: Purpose,
+        start: Option<&Path>,
+        repaint: std::sync::Arc<dyn Fn() + Send + Sync>,
+    ) -> Option<NativeDialog> {
         if !Self::available() {
             return None;
         }
@@ -49,7 +55,11 @@ impl NativeDialog {
                 repaint();
             })
             .ok()?;
-        Some(NativeDialog { purpose, started: Instant::now(), rx })
+        Some(NativeDialog {
+            purpose,
+            started: Instant::now(),
+            rx,
+        })
     }
 
     /// The answer, once there is one.
@@ -68,13 +78,21 @@ impl NativeDialog {
 fn run(purpose: Purpose, start: Option<&Path>) -> Option<PathBuf> {
     let mut d = rfd::FileDialog::new().add_filter(purpose.filter_name(), purpose.extensions());
     if let Some(p) = start {
-        let (dir, name) = if p.is_dir() { (Some(p), None) } else { (p.parent(), p.file_name()) };
+        let (dir, name) = if p.is_dir() {
+            (Some(p), None)
+        } else {
+            (p.parent(), p.file_name())
+        };
         if let Some(dir) = dir.filter(|d| !d.as_os_str().is_empty()) {
             d = d.set_directory(dir);
         }
         if let Some(name) = name.filter(|_| purpose != Purpose::Open) {
             let name = Path::new(name);
-            let name = if purpose == Purpose::Export { name.with_extension("png") } else { name.to_path_buf() };
+            let name = if purpose == Purpose::Export {
+                name.with_extension("png")
+            } else {
+                name.to_path_buf()
+            };
             d = d.set_file_name(name.to_string_lossy());
         }
     }

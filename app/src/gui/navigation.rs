@@ -68,9 +68,15 @@ impl ViewBasis {
         let p = self.screen(px);
         let (sx, sy) = ((p.x - 0.5) * self.extent, (p.y - 0.5) * self.extent);
         if self.perspective {
-            (self.center, (self.direction + sx * self.horizontal + sy * self.up).normalize())
+            (
+                self.center,
+                (self.direction + sx * self.horizontal + sy * self.up).normalize(),
+            )
         } else {
-            (self.center + sx * self.horizontal + sy * self.up, self.direction)
+            (
+                self.center + sx * self.horizontal + sy * self.up,
+                self.direction,
+            )
         }
     }
 
@@ -100,7 +106,11 @@ impl ViewBasis {
 
     /// World units per image pixel at depth `depth` (in the image plane).
     pub fn world_per_pixel(&self, depth: f32) -> f32 {
-        let at = if self.perspective { depth.max(1e-4) } else { 1.0 };
+        let at = if self.perspective {
+            depth.max(1e-4)
+        } else {
+            1.0
+        };
         at * self.extent / self.span()
     }
 }
@@ -115,7 +125,10 @@ pub struct OnScreen {
 
 impl OnScreen {
     pub fn new(camera: &Camera, width: u32, height: u32, rect: egui::Rect) -> Self {
-        OnScreen { basis: ViewBasis::new(camera, width, height), rect }
+        OnScreen {
+            basis: ViewBasis::new(camera, width, height),
+            rect,
+        }
     }
 
     /// Image pixels per screen point.
@@ -124,12 +137,18 @@ impl OnScreen {
     }
 
     pub fn to_pixels(&self, p: egui::Pos2) -> Vec2 {
-        let k = Vec2::new(self.basis.width / self.rect.width().max(1e-3), self.basis.height / self.rect.height().max(1e-3));
+        let k = Vec2::new(
+            self.basis.width / self.rect.width().max(1e-3),
+            self.basis.height / self.rect.height().max(1e-3),
+        );
         Vec2::new(p.x - self.rect.min.x, p.y - self.rect.min.y) * k
     }
 
     pub fn to_screen(&self, px: Vec2) -> egui::Pos2 {
-        let k = Vec2::new(self.rect.width() / self.basis.width, self.rect.height() / self.basis.height);
+        let k = Vec2::new(
+            self.rect.width() / self.basis.width,
+            self.rect.height() / self.basis.height,
+        );
         egui::pos2(self.rect.min.x + px.x * k.x, self.rect.min.y + px.y * k.y)
     }
 
@@ -149,8 +168,18 @@ impl OnScreen {
 
 fn with_pose(camera: &Camera, center: Vec3, direction: Vec3, up: Vec3) -> Camera {
     match *camera {
-        Camera::Orthographic { size, .. } => Camera::Orthographic { center, direction, up, size },
-        Camera::Perspective { angle, .. } => Camera::Perspective { center, direction, up, angle },
+        Camera::Orthographic { size, .. } => Camera::Orthographic {
+            center,
+            direction,
+            up,
+            size,
+        },
+        Camera::Perspective { angle, .. } => Camera::Perspective {
+            center,
+            direction,
+            up,
+            angle,
+        },
     }
 }
 
@@ -173,7 +202,8 @@ pub fn orbit(start: &Camera, pivot: Vec3, yaw: f32, pitch: f32) -> Camera {
     let target = (elevation + pitch).clamp((-limit).min(elevation), limit.max(elevation));
     let pitch = target - elevation;
     let right = dir.cross(axis).normalize_or(Vec3::X);
-    let rot = Quat::from_axis_angle(axis, yaw.to_radians()) * Quat::from_axis_angle(right, pitch.to_radians());
+    let rot = Quat::from_axis_angle(axis, yaw.to_radians())
+        * Quat::from_axis_angle(right, pitch.to_radians());
     let center = pivot + rot * (c - pivot);
     let direction = rot * d;
     with_pose(start, center, direction, up)
@@ -193,17 +223,37 @@ pub fn pan(start: &Camera, basis: &ViewBasis, depth: f32, dx: f32, dy: f32) -> C
 pub fn zoom(start: &Camera, toward: Vec3, notches: f32) -> Camera {
     let f = ZOOM_PER_NOTCH.powf(-notches);
     match *start {
-        Camera::Perspective { center, direction, up, angle } => {
+        Camera::Perspective {
+            center,
+            direction,
+            up,
+            angle,
+        } => {
             // A homothety about `toward` keeps its image fixed and its distance × f.
-            Camera::Perspective { center: toward + (center - toward) * f, direction, up, angle }
+            Camera::Perspective {
+                center: toward + (center - toward) * f,
+                direction,
+                up,
+                angle,
+            }
         }
-        Camera::Orthographic { center, direction, up, size } => {
+        Camera::Orthographic {
+            center,
+            direction,
+            up,
+            size,
+        } => {
             let d = unit(direction).unwrap_or(Vec3::NEG_Z);
             let off = center - toward;
             // Shrink only the part across the view: the depth of an orthographic camera
             // changes nothing on screen.
             let across = off - d * off.dot(d);
-            Camera::Orthographic { center: center - across * (1.0 - f), direction, up, size: size * f }
+            Camera::Orthographic {
+                center: center - across * (1.0 - f),
+                direction,
+                up,
+                size: size * f,
+            }
         }
     }
 }
@@ -219,14 +269,29 @@ pub fn frame(start: &Camera, min: Vec3, max: Vec3, width: u32, height: u32) -> C
     let margin = 1.1;
     let dir = unit(start.direction()).unwrap_or(Vec3::NEG_Z);
     match *start {
-        Camera::Perspective { direction, up, angle, .. } => {
+        Camera::Perspective {
+            direction,
+            up,
+            angle,
+            ..
+        } => {
             let half = ((angle.to_radians() * 0.5).tan() * small).atan();
             let distance = r * margin / half.sin();
-            Camera::Perspective { center: c - dir * distance, direction, up, angle }
+            Camera::Perspective {
+                center: c - dir * distance,
+                direction,
+                up,
+                angle,
+            }
         }
         Camera::Orthographic { direction, up, .. } => {
             let size = 2.0 * r * margin / small;
-            Camera::Orthographic { center: c - dir * (2.0 * r + 1.0), direction, up, size }
+            Camera::Orthographic {
+                center: c - dir * (2.0 * r + 1.0),
+                direction,
+                up,
+                size,
+            }
         }
     }
 }
@@ -253,9 +318,22 @@ impl AxisView {
 }
 
 /// The camera turned to an axis view (same kind, angle or size), then framed on the box.
-pub fn axis_view(start: &Camera, view: AxisView, min: Vec3, max: Vec3, width: u32, height: u32) -> Camera {
+pub fn axis_view(
+    start: &Camera,
+    view: AxisView,
+    min: Vec3,
+    max: Vec3,
+    width: u32,
+    height: u32,
+) -> Camera {
     let (d, up) = view.direction_up();
-    frame(&with_pose(start, start.center(), d, up), min, max, width, height)
+    frame(
+        &with_pose(start, start.center(), d, up),
+        min,
+        max,
+        width,
+        height,
+    )
 }
 
 #[cfg(test)]
@@ -264,12 +342,22 @@ mod tests {
     use tracelab_core::render::CameraRays;
 
     fn persp() -> Camera {
-        Camera::Perspective { center: Vec3::new(0.0, 0.8, 5.0), direction: Vec3::new(0.0, 0.0, -2.0), up: Vec3::Y, angle: 30.0 }
+        Camera::Perspective {
+            center: Vec3::new(0.0, 0.8, 5.0),
+            direction: Vec3::new(0.0, 0.0, -2.0),
+            up: Vec3::Y,
+            angle: 30.0,
+        }
     }
 
     #[test]
     fn rays_match_the_renderers_for_both_kinds_and_odd_sizes() {
-        let ortho = Camera::Orthographic { center: Vec3::new(1.0, 2.0, 9.0), direction: Vec3::new(0.2, -0.1, -1.0), up: Vec3::new(0.1, 1.0, 0.3), size: 4.5 };
+        let ortho = Camera::Orthographic {
+            center: Vec3::new(1.0, 2.0, 9.0),
+            direction: Vec3::new(0.2, -0.1, -1.0),
+            up: Vec3::new(0.1, 1.0, 0.3),
+            size: 4.5,
+        };
         for cam in [persp(), ortho] {
             let core = CameraRays::new(&cam);
             for (w, h) in [(7u32, 3u32), (3, 7), (680, 656)] {
@@ -277,10 +365,16 @@ mod tests {
                 for (i, row) in [(0, 0), (w - 1, h - 1), (w / 2, h / 3)] {
                     let r = core.pixel_ray(i, row, w, h);
                     let (o, d) = b.ray(Vec2::new(i as f32 + 0.5, row as f32 + 0.5));
-                    assert!((o - r.origin).length() < 1e-4 && (d - r.direction).length() < 1e-5, "{w}x{h} ({i},{row})");
+                    assert!(
+                        (o - r.origin).length() < 1e-4 && (d - r.direction).length() < 1e-5,
+                        "{w}x{h} ({i},{row})"
+                    );
                     // And a point on that ray projects back to the pixel's centre.
                     let p = b.project(o + d * 3.0).expect("in front");
-                    assert!((p - Vec2::new(i as f32 + 0.5, row as f32 + 0.5)).length() < 1e-2, "{p}");
+                    assert!(
+                        (p - Vec2::new(i as f32 + 0.5, row as f32 + 0.5)).length() < 1e-2,
+                        "{p}"
+                    );
                 }
             }
         }
@@ -288,32 +382,58 @@ mod tests {
 
     #[test]
     fn orbit_keeps_the_pivot_on_screen_and_up_as_written() {
-        let cam = Camera::Perspective { center: Vec3::new(1.0, 2.0, 6.0), direction: Vec3::new(-0.1, -0.3, -1.0), up: Vec3::new(0.0, 2.0, 0.5), angle: 40.0 };
+        let cam = Camera::Perspective {
+            center: Vec3::new(1.0, 2.0, 6.0),
+            direction: Vec3::new(-0.1, -0.3, -1.0),
+            up: Vec3::new(0.0, 2.0, 0.5),
+            angle: 40.0,
+        };
         let b = ViewBasis::new(&cam, 400, 300);
         let pivot = cam.center() + Vec3::new(0.3, -0.1, -1.0) * 4.0;
         let before = b.project(pivot).expect("visible");
         let after_cam = orbit(&cam, pivot, 35.0, -20.0);
-        let after = ViewBasis::new(&after_cam, 400, 300).project(pivot).expect("visible");
+        let after = ViewBasis::new(&after_cam, 400, 300)
+            .project(pivot)
+            .expect("visible");
         assert!((before - after).length() < 1e-2, "{before} {after}");
         assert_eq!(after_cam.up(), cam.up());
         // No roll: the screen's right stays perpendicular to the up axis.
-        assert!(ViewBasis::new(&after_cam, 400, 300).horizontal.dot(cam.up().normalize()).abs() < 1e-5);
+        assert!(
+            ViewBasis::new(&after_cam, 400, 300)
+                .horizontal
+                .dot(cam.up().normalize())
+                .abs()
+                < 1e-5
+        );
     }
 
     #[test]
     fn orbit_stops_short_of_the_pole() {
         let cam = persp();
         let down = orbit(&cam, Vec3::ZERO, 0.0, -500.0);
-        let e = unit(down.direction()).expect("dir").dot(Vec3::Y).asin().to_degrees();
+        let e = unit(down.direction())
+            .expect("dir")
+            .dot(Vec3::Y)
+            .asin()
+            .to_degrees();
         assert!((e - (-MAX_ELEVATION_DEGREES)).abs() < 1e-3, "{e}");
         let up = orbit(&cam, Vec3::ZERO, 0.0, 500.0);
-        let e = unit(up.direction()).expect("dir").dot(Vec3::Y).asin().to_degrees();
+        let e = unit(up.direction())
+            .expect("dir")
+            .dot(Vec3::Y)
+            .asin()
+            .to_degrees();
         assert!((e - MAX_ELEVATION_DEGREES).abs() < 1e-3, "{e}");
     }
 
     #[test]
     fn zoom_keeps_the_point_toward_on_screen() {
-        let ortho = Camera::Orthographic { center: Vec3::new(0.0, 0.0, 10.0), direction: Vec3::NEG_Z, up: Vec3::Y, size: 5.0 };
+        let ortho = Camera::Orthographic {
+            center: Vec3::new(0.0, 0.0, 10.0),
+            direction: Vec3::NEG_Z,
+            up: Vec3::Y,
+            size: 5.0,
+        };
         for cam in [persp(), ortho] {
             let p = Vec3::new(0.7, 0.2, 0.0);
             let before = ViewBasis::new(&cam, 300, 300).project(p).expect("visible");
@@ -337,7 +457,10 @@ mod tests {
                     if i & 4 == 0 { min.z } else { max.z },
                 );
                 let p = b.project(corner).expect("in front");
-                assert!(p.x > 0.0 && p.y > 0.0 && p.x < w as f32 && p.y < h as f32, "{p} in {w}x{h}");
+                assert!(
+                    p.x > 0.0 && p.y > 0.0 && p.x < w as f32 && p.y < h as f32,
+                    "{p} in {w}x{h}"
+                );
             }
         }
     }

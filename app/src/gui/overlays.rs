@@ -18,7 +18,11 @@ pub fn outline(frame: &Frame, nodes: &[bool]) -> Option<egui::ColorImage> {
         return None;
     }
     // A table, not a set: this runs over every pixel on the UI thread.
-    let inside: Vec<bool> = frame.samples.iter().map(|s| nodes.get(s.node as usize).copied().unwrap_or(false)).collect();
+    let inside: Vec<bool> = frame
+        .samples
+        .iter()
+        .map(|s| nodes.get(s.node as usize).copied().unwrap_or(false))
+        .collect();
     let at = |x: usize, y: usize| inside.get(y * w + x).copied().unwrap_or(false);
     let mut rgba = vec![0u8; w * h * 4];
     let mut any = false;
@@ -27,7 +31,14 @@ pub fn outline(frame: &Frame, nodes: &[bool]) -> Option<egui::ColorImage> {
             if !at(x, y) {
                 continue;
             }
-            let edge = x == 0 || y == 0 || x + 1 == w || y + 1 == h || !at(x - 1, y) || !at(x + 1, y) || !at(x, y - 1) || !at(x, y + 1);
+            let edge = x == 0
+                || y == 0
+                || x + 1 == w
+                || y + 1 == h
+                || !at(x - 1, y)
+                || !at(x + 1, y)
+                || !at(x, y - 1)
+                || !at(x, y + 1);
             if edge {
                 rgba[(y * w + x) * 4..][..4].copy_from_slice(&OUTLINE);
                 any = true;
@@ -64,11 +75,20 @@ pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
     ];
     // Farthest first, so the nearer axes draw over it.
     let mut order: Vec<_> = axes.iter().collect();
-    order.sort_by(|a, b| b.0.dot(basis.direction).total_cmp(&a.0.dot(basis.direction)));
+    order.sort_by(|a, b| {
+        b.0.dot(basis.direction)
+            .total_cmp(&a.0.dot(basis.direction))
+    });
     for (d, name, c) in order {
         let v = on_screen(basis, *d) * 20.0;
         painter.line_segment([o, o + v], egui::Stroke::new(2.0, *c));
-        painter.text(o + v * 1.2, egui::Align2::CENTER_CENTER, *name, egui::FontId::monospace(11.0), *c);
+        painter.text(
+            o + v * 1.2,
+            egui::Align2::CENTER_CENTER,
+            *name,
+            egui::FontId::monospace(11.0),
+            *c,
+        );
     }
 }
 
@@ -76,10 +96,18 @@ pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
 /// right corner, in the light's colour.
 pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scene: &Scene) {
     for (i, l) in scene.lights().iter().enumerate() {
-        let Some(d) = tracelab_core::scene::unit(l.direction) else { continue };
+        let Some(d) = tracelab_core::scene::unit(l.direction) else {
+            continue;
+        };
         let c = l.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
-        let colour = egui::Color32::from_rgb(c.x as u8, c.y as u8, c.z as u8).gamma_multiply(0.5).to_opaque();
-        let colour = if colour.r().max(colour.g()).max(colour.b()) < 60 { egui::Color32::LIGHT_GRAY } else { colour };
+        let colour = egui::Color32::from_rgb(c.x as u8, c.y as u8, c.z as u8)
+            .gamma_multiply(0.5)
+            .to_opaque();
+        let colour = if colour.r().max(colour.g()).max(colour.b()) < 60 {
+            egui::Color32::LIGHT_GRAY
+        } else {
+            colour
+        };
         let o = rect.right_top() + egui::vec2(-34.0 - 60.0 * i as f32, 34.0);
         painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
         let v = on_screen(basis, d) * 20.0;
@@ -89,15 +117,27 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
             let stroke = egui::Stroke::new(2.0, colour);
             painter.circle_stroke(o, 7.0, stroke);
             if d.dot(basis.direction) > 0.0 {
-                painter.line_segment([o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)], stroke);
-                painter.line_segment([o + egui::vec2(-5.0, 5.0), o + egui::vec2(5.0, -5.0)], stroke);
+                painter.line_segment(
+                    [o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)],
+                    stroke,
+                );
+                painter.line_segment(
+                    [o + egui::vec2(-5.0, 5.0), o + egui::vec2(5.0, -5.0)],
+                    stroke,
+                );
             } else {
                 painter.circle_filled(o, 2.5, colour);
             }
         } else {
             painter.arrow(o - v * 0.5, v, egui::Stroke::new(2.0, colour));
         }
-        painter.text(o + egui::vec2(0.0, 18.0), egui::Align2::CENTER_TOP, format!("light {i}"), egui::FontId::proportional(10.0), colour);
+        painter.text(
+            o + egui::vec2(0.0, 18.0),
+            egui::Align2::CENTER_TOP,
+            format!("light {i}"),
+            egui::FontId::proportional(10.0),
+            colour,
+        );
     }
 }
 
@@ -111,13 +151,22 @@ mod tests {
         let mut f = Frame::new(5, 5);
         for y in 1..4 {
             for x in 1..4 {
-                f.samples[y * 5 + x] = Sample { node: 7, ..Sample::UNSET };
+                f.samples[y * 5 + x] = Sample {
+                    node: 7,
+                    ..Sample::UNSET
+                };
             }
         }
         let mut seven = vec![false; 9];
         seven[7] = true;
         let img = outline(&f, &seven).expect("drawn");
-        let lit: Vec<usize> = img.pixels.iter().enumerate().filter(|(_, c)| c.a() > 0).map(|(i, _)| i).collect();
+        let lit: Vec<usize> = img
+            .pixels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.a() > 0)
+            .map(|(i, _)| i)
+            .collect();
         // The 3×3 block's ring of 8, not its centre.
         assert_eq!(lit.len(), 8);
         assert!(!lit.contains(&12));

@@ -75,11 +75,19 @@ impl Diagram {
     /// the ray's origin is left out, being often ten times further than the object is big;
     /// the view zooms out to it.
     pub fn bounds(&self) -> (Vec3, f32) {
-        let pts: Vec<Vec3> = self.items.iter().flat_map(Item::fit_points).filter(|p| p.is_finite()).collect();
+        let pts: Vec<Vec3> = self
+            .items
+            .iter()
+            .flat_map(Item::fit_points)
+            .filter(|p| p.is_finite())
+            .collect();
         if pts.is_empty() {
             return (Vec3::ZERO, 1.0);
         }
-        let (lo, hi) = pts.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let (lo, hi) = pts.iter().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
         let c = (lo + hi) * 0.5;
         let r = pts.iter().map(|p| (*p - c).length()).fold(0.0f32, f32::max);
         (c, r.max(1e-6))
@@ -104,7 +112,13 @@ fn outline(kind: &NodeKind, near: Vec3) -> Vec<Vec<Vec3>> {
             .collect()
     };
     let boxed = |lo: Vec3, hi: Vec3| -> Vec<Vec<Vec3>> {
-        let p = |i: u32| Vec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+        let p = |i: u32| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
         let mut edges = Vec::new();
         for i in 0..8u32 {
             for bit in [1, 2, 4] {
@@ -116,10 +130,17 @@ fn outline(kind: &NodeKind, near: Vec3) -> Vec<Vec<Vec3>> {
         edges
     };
     match kind {
-        NodeKind::Sphere { center, radius } => (0..3).map(|a| circle(*center, *radius, a)).collect(),
+        NodeKind::Sphere { center, radius } => {
+            (0..3).map(|a| circle(*center, *radius, a)).collect()
+        }
         NodeKind::Box { min, max } => boxed(*min, *max),
-        NodeKind::Triangle { vertices: [a, b, c] } => vec![vec![*a, *b, *c, *a]],
-        NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(m), .. } => {
+        NodeKind::Triangle {
+            vertices: [a, b, c],
+        } => vec![vec![*a, *b, *c, *a]],
+        NodeKind::TriangleMesh {
+            mesh: MeshSlot::Loaded(m),
+            ..
+        } => {
             let b = m.bounds();
             boxed(b.min, b.max)
         }
@@ -130,7 +151,13 @@ fn outline(kind: &NodeKind, near: Vec3) -> Vec<Vec<Vec3>> {
             let u = n.any_orthonormal_vector();
             let v = n.cross(u);
             let s = 1.5;
-            vec![vec![c + (u + v) * s, c + (u - v) * s, c - (u + v) * s, c + (v - u) * s, c + (u + v) * s]]
+            vec![vec![
+                c + (u + v) * s,
+                c + (u - v) * s,
+                c - (u + v) * s,
+                c + (v - u) * s,
+                c + (u + v) * s,
+            ]]
         }
         _ => Vec::new(),
     }
@@ -150,9 +177,22 @@ pub fn diagrams(scene: &Scene, story: &RayStory) -> Option<(Diagram, Diagram)> {
     }
     let m = m.as_mat4();
     let lines = outline(kind, h.object_point);
-    let size_obj = lines.iter().flatten().map(|p| (*p - h.object_point).length()).fold(0.0f32, f32::max).max(0.5);
-    let world_lines: Vec<Vec<Vec3>> = lines.iter().map(|l| l.iter().map(|p| m.transform_point3(*p)).collect()).collect();
-    let size_world = world_lines.iter().flatten().map(|p| (*p - h.world_point).length()).fold(0.0f32, f32::max).max(0.5);
+    let size_obj = lines
+        .iter()
+        .flatten()
+        .map(|p| (*p - h.object_point).length())
+        .fold(0.0f32, f32::max)
+        .max(0.5);
+    let world_lines: Vec<Vec<Vec3>> = lines
+        .iter()
+        .map(|l| l.iter().map(|p| m.transform_point3(*p)).collect())
+        .collect();
+    let size_world = world_lines
+        .iter()
+        .flatten()
+        .map(|p| (*p - h.world_point).length())
+        .fold(0.0f32, f32::max)
+        .max(0.5);
     let arrow = size_world * 0.6;
 
     let mut world = Diagram::default();
@@ -160,35 +200,85 @@ pub fn diagrams(scene: &Scene, story: &RayStory) -> Option<(Diagram, Diagram)> {
         Camera::Orthographic { .. } => "ray origin (on the image plane)",
         Camera::Perspective { .. } => "eye",
     };
-    world.items.push(Item::new(Role::Eye, Shape::Point(story.world_ray.origin), Some(eye.into())));
-    world.items.push(Item::new(Role::Ray, Shape::Line(vec![story.world_ray.origin, h.world_point]), Some(format!("t = {:.3}", h.t))));
+    world.items.push(Item::new(
+        Role::Eye,
+        Shape::Point(story.world_ray.origin),
+        Some(eye.into()),
+    ));
+    world.items.push(Item::new(
+        Role::Ray,
+        Shape::Line(vec![story.world_ray.origin, h.world_point]),
+        Some(format!("t = {:.3}", h.t)),
+    ));
     for l in world_lines {
-        world.items.push(Item::new(Role::Outline, Shape::Line(l), None));
+        world
+            .items
+            .push(Item::new(Role::Outline, Shape::Line(l), None));
     }
-    world.items.push(Item::new(Role::Hit, Shape::Point(h.world_point), Some("hit".into())));
+    world.items.push(Item::new(
+        Role::Hit,
+        Shape::Point(h.world_point),
+        Some("hit".into()),
+    ));
     let p = h.world_point;
-    world.items.push(Item::new(Role::NormalCorrect, Shape::Arrow(p, p + h.normal_correct * arrow), Some("(M^-1)^T n".into())));
-    world.items.push(Item::new(Role::NormalIncorrect, Shape::Arrow(p, p + h.normal_incorrect * arrow), Some("M n".into())));
+    world.items.push(Item::new(
+        Role::NormalCorrect,
+        Shape::Arrow(p, p + h.normal_correct * arrow),
+        Some("(M^-1)^T n".into()),
+    ));
+    world.items.push(Item::new(
+        Role::NormalIncorrect,
+        Shape::Arrow(p, p + h.normal_incorrect * arrow),
+        Some("M n".into()),
+    ));
     let u = h.normal_correct.any_orthonormal_vector() * arrow * 0.5;
     let v = h.normal_correct.cross(u);
-    world.items.push(Item::new(Role::Tangent, Shape::Line(vec![p + u + v, p + u - v, p - u - v, p - u + v, p + u + v]), None));
+    world.items.push(Item::new(
+        Role::Tangent,
+        Shape::Line(vec![p + u + v, p + u - v, p - u - v, p - u + v, p + u + v]),
+        None,
+    ));
     for (i, l) in h.shade.lights.iter().enumerate() {
-        world.items.push(Item::new(Role::Light, Shape::Arrow(p, p + l.l * arrow), Some(format!("L{i}"))));
+        world.items.push(Item::new(
+            Role::Light,
+            Shape::Arrow(p, p + l.l * arrow),
+            Some(format!("L{i}")),
+        ));
     }
 
     let mut object = Diagram::default();
     let (o, d) = (h.object_ray.origin, h.object_ray.direction);
-    object.items.push(Item::new(Role::Eye, Shape::Point(o), Some("M^-1 o".into())));
-    object.items.push(Item::new(Role::Ray, Shape::Line(vec![o, h.object_point]), Some(format!("t = {:.3}", h.t))));
+    object
+        .items
+        .push(Item::new(Role::Eye, Shape::Point(o), Some("M^-1 o".into())));
+    object.items.push(Item::new(
+        Role::Ray,
+        Shape::Line(vec![o, h.object_point]),
+        Some(format!("t = {:.3}", h.t)),
+    ));
     // The direction with its own length, |M⁻¹d| (not renormalised), as the ray's last unit
     // of t before the hit, where it is in view.
     let q = h.object_point;
-    object.items.push(Item::new(Role::Direction, Shape::Arrow(q - d, q), Some(format!("M^-1 d, length {:.3}", d.length()))));
+    object.items.push(Item::new(
+        Role::Direction,
+        Shape::Arrow(q - d, q),
+        Some(format!("M^-1 d, length {:.3}", d.length())),
+    ));
     for l in lines {
-        object.items.push(Item::new(Role::Outline, Shape::Line(l), None));
+        object
+            .items
+            .push(Item::new(Role::Outline, Shape::Line(l), None));
     }
-    object.items.push(Item::new(Role::Hit, Shape::Point(h.object_point), Some("hit".into())));
-    object.items.push(Item::new(Role::NormalCorrect, Shape::Arrow(q, q + h.object_normal * size_obj * 0.6), Some("n".into())));
+    object.items.push(Item::new(
+        Role::Hit,
+        Shape::Point(h.object_point),
+        Some("hit".into()),
+    ));
+    object.items.push(Item::new(
+        Role::NormalCorrect,
+        Shape::Arrow(q, q + h.object_normal * size_obj * 0.6),
+        Some("n".into()),
+    ));
     Some((world, object))
 }
 
@@ -204,7 +294,11 @@ pub struct Orbit {
 impl Default for Orbit {
     /// Slightly from above and the side, so depth along the ray shows.
     fn default() -> Self {
-        Orbit { yaw: 0.6, pitch: 0.35, zoom: 1.0 }
+        Orbit {
+            yaw: 0.6,
+            pitch: 0.35,
+            zoom: 1.0,
+        }
     }
 }
 
@@ -231,7 +325,14 @@ impl Orbit {
 
     /// Where `p` lands in a rectangle centred on `screen_center` holding a ball of `radius`
     /// around `center` in `half_extent` points (screen y grows downward).
-    pub fn project(&self, p: Vec3, center: Vec3, radius: f32, screen_center: Vec2, half_extent: f32) -> Vec2 {
+    pub fn project(
+        &self,
+        p: Vec3,
+        center: Vec3,
+        radius: f32,
+        screen_center: Vec2,
+        half_extent: f32,
+    ) -> Vec2 {
         let (right, up) = self.axes();
         let q = p - center;
         let s = half_extent / radius * self.zoom;
@@ -246,22 +347,25 @@ mod tests {
     use tracelab_core::scene::validate::compose_f64;
     use tracelab_core::{CompiledScene, MeshCache, RenderSettings, parse_scene};
 
-/// The composed world-from-object matrix of the node a story hit, from its path (f64).
-fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
-    let h = story.hit.as_ref()?;
-    let g = &scene.graph;
-    let mut m = DMat4::IDENTITY;
-    for id in g.path_to(h.node)? {
-        if let Some(NodeKind::Transform(ops)) = g.get(id).map(|n| &n.kind) {
-            m *= compose_f64(ops);
+    /// The composed world-from-object matrix of the node a story hit, from its path (f64).
+    fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
+        let h = story.hit.as_ref()?;
+        let g = &scene.graph;
+        let mut m = DMat4::IDENTITY;
+        for id in g.path_to(h.node)? {
+            if let Some(NodeKind::Transform(ops)) = g.get(id).map(|n| &n.kind) {
+                m *= compose_f64(ops);
+            }
         }
+        Some(m)
     }
-    Some(m)
-}
 
     fn sheared() -> Scene {
         let text = include_str!("../../../scenes/sheared_sphere.txt");
-        parse_scene(text.as_bytes(), "s.txt", None, &mut MeshCache::new()).into_result().expect("parses").0
+        parse_scene(text.as_bytes(), "s.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("parses")
+            .0
     }
 
     fn arrow(d: &Diagram, role: Role) -> (Vec3, Vec3) {
@@ -305,7 +409,9 @@ fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
         let inv = m.inverse();
         let mut n = 0;
         for item in world.find(Role::Outline) {
-            let Shape::Line(ps) = &item.shape else { panic!("outline is lines") };
+            let Shape::Line(ps) = &item.shape else {
+                panic!("outline is lines")
+            };
             for p in ps {
                 assert!((inv.transform_point3(*p).length() - 1.0).abs() < 1e-4);
                 n += 1;
@@ -313,7 +419,9 @@ fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
         }
         assert!(n > 100);
         // The tangent square is perpendicular to the correct normal.
-        let Some(Shape::Line(sq)) = world.find(Role::Tangent).next().map(|i| &i.shape) else { panic!("tangent") };
+        let Some(Shape::Line(sq)) = world.find(Role::Tangent).next().map(|i| &i.shape) else {
+            panic!("tangent")
+        };
         for p in sq {
             assert!((*p - h.world_point).dot(h.normal_correct).abs() < 1e-5);
         }
@@ -325,11 +433,23 @@ fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
         let c = CompiledScene::new(&s);
         let story = inspect_pixel(&s, &c, &RenderSettings::new(40, 40), 28, 18);
         let (world, object) = diagrams(&s, &story).expect("diagrams");
-        for (d, orbit) in [(&world, Orbit::default()), (&object, Orbit { yaw: -1.1, pitch: 0.9, zoom: 1.0 })] {
+        for (d, orbit) in [
+            (&world, Orbit::default()),
+            (
+                &object,
+                Orbit {
+                    yaw: -1.1,
+                    pitch: 0.9,
+                    zoom: 1.0,
+                },
+            ),
+        ] {
             let (center, r) = d.bounds();
             let sc = Vec2::new(100.0, 80.0);
             let proj = |p: Vec3| orbit.project(p, center, r, sc, 70.0);
-            let Some(Shape::Line(ray)) = d.find(Role::Ray).next().map(|i| &i.shape) else { panic!("ray") };
+            let Some(Shape::Line(ray)) = d.find(Role::Ray).next().map(|i| &i.shape) else {
+                panic!("ray")
+            };
             let (a, b) = (proj(ray[0]), proj(ray[1]));
             let hit = proj(point(d, Role::Hit));
             // Projection is linear: the hit, at the end of the drawn ray, lands on its end.
@@ -343,12 +463,28 @@ fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
             }
         }
         // Seen from the front (no yaw, no pitch), x goes right and y goes up on screen.
-        let front = Orbit { yaw: 0.0, pitch: 0.0, zoom: 1.0 };
+        let front = Orbit {
+            yaw: 0.0,
+            pitch: 0.0,
+            zoom: 1.0,
+        };
         let o = front.project(Vec3::ZERO, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0);
-        assert_eq!(front.project(Vec3::X, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o, Vec2::new(10.0, 0.0));
-        assert_eq!(front.project(Vec3::Y, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o, Vec2::new(0.0, -10.0));
-        assert_eq!(front.project(Vec3::Z, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o, Vec2::ZERO);
+        assert_eq!(
+            front.project(Vec3::X, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o,
+            Vec2::new(10.0, 0.0)
+        );
+        assert_eq!(
+            front.project(Vec3::Y, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o,
+            Vec2::new(0.0, -10.0)
+        );
+        assert_eq!(
+            front.project(Vec3::Z, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0) - o,
+            Vec2::ZERO
+        );
         let closer = Orbit { zoom: 2.0, ..front };
-        assert_eq!(closer.project(Vec3::X, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0), Vec2::new(20.0, 0.0));
+        assert_eq!(
+            closer.project(Vec3::X, Vec3::ZERO, 1.0, Vec2::ZERO, 10.0),
+            Vec2::new(20.0, 0.0)
+        );
     }
 }

@@ -26,7 +26,13 @@ pub struct Settings {
 impl Default for Settings {
     fn default() -> Self {
         let view = ViewSettings::default();
-        Settings { recent: Vec::new(), tab: view.tab, shade_back: view.shade_back, depth: view.depth, layout_epoch: 0 }
+        Settings {
+            recent: Vec::new(),
+            tab: view.tab,
+            shade_back: view.shade_back,
+            depth: view.depth,
+            layout_epoch: 0,
+        }
     }
 }
 
@@ -44,13 +50,21 @@ impl Settings {
 /// The keys `recent`, `view` and `layout` of earlier versions, read once so that an upgrade
 /// keeps the recent files and the view; the next save writes [`KEY`] instead.
 fn legacy(s: &dyn eframe::Storage) -> Option<Settings> {
-    let (recent, view, layout) = (s.get_string("recent"), s.get_string("view"), s.get_string("layout"));
+    let (recent, view, layout) = (
+        s.get_string("recent"),
+        s.get_string("view"),
+        s.get_string("layout"),
+    );
     if recent.is_none() && view.is_none() && layout.is_none() {
         return None;
     }
     let mut out = Settings::default();
     if let Some(r) = recent {
-        out.recent = r.lines().filter(|l| !l.is_empty()).map(PathBuf::from).collect();
+        out.recent = r
+            .lines()
+            .filter(|l| !l.is_empty())
+            .map(PathBuf::from)
+            .collect();
     }
     if let Some(v) = view {
         let mut it = v.split(' ');
@@ -94,7 +108,13 @@ mod tests {
 
     #[test]
     fn settings_read_back_as_saved() {
-        let s = Settings { recent: vec!["a b/c.txt".into()], tab: Tab::All, shade_back: true, depth: (-1.5, 3.0), layout_epoch: 2 };
+        let s = Settings {
+            recent: vec!["a b/c.txt".into()],
+            tab: Tab::All,
+            shade_back: true,
+            depth: (-1.5, 3.0),
+            layout_epoch: 2,
+        };
         let mut m = Mem::default();
         s.save(&mut m);
         assert_eq!(Settings::load(&m), Some(s));
@@ -107,7 +127,13 @@ mod tests {
         eframe::Storage::set_string(&mut m, "view", "depth 1 3 12.5".into());
         eframe::Storage::set_string(&mut m, "layout", "4".into());
         let s = Settings::load(&m).expect("read");
-        assert_eq!(s.recent, [PathBuf::from("/x/one.txt"), PathBuf::from("/y/two.txt")]);
-        assert_eq!((s.tab, s.shade_back, s.depth, s.layout_epoch), (Tab::Depth, true, (3.0, 12.5), 4));
+        assert_eq!(
+            s.recent,
+            [PathBuf::from("/x/one.txt"), PathBuf::from("/y/two.txt")]
+        );
+        assert_eq!(
+            (s.tab, s.shade_back, s.depth, s.layout_epoch),
+            (Tab::Depth, true, (3.0, 12.5), 4)
+        );
     }
 }

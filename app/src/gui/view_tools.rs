@@ -20,8 +20,15 @@ use crate::gui::navigation::{self, OnScreen, ViewBasis};
 pub const STILL_AFTER: Duration = Duration::from_millis(150);
 
 enum Tool {
-    Orbit { camera: Camera, pivot: Vec3 },
-    Pan { camera: Camera, basis: ViewBasis, depth: f32 },
+    Orbit {
+        camera: Camera,
+        pivot: Vec3,
+    },
+    Pan {
+        camera: Camera,
+        basis: ViewBasis,
+        depth: f32,
+    },
     Gizmo(GizmoDrag),
 }
 
@@ -59,7 +66,10 @@ fn fallback_pivot(doc: &Document) -> Vec3 {
         _ => None,
     };
     sel.or_else(|| world_bounds(&doc.scene, doc.scene.graph.root()).map(|(a, b)| (a + b) * 0.5))
-        .unwrap_or_else(|| doc.scene.camera.center() + doc.scene.camera.direction().normalize_or(Vec3::NEG_Z) * 10.0)
+        .unwrap_or_else(|| {
+            doc.scene.camera.center()
+                + doc.scene.camera.direction().normalize_or(Vec3::NEG_Z) * 10.0
+        })
 }
 
 /// Wheel notches this frame (positive: away from the user, which zooms in).
@@ -101,7 +111,8 @@ impl ViewTools {
 
     /// Whether wheel notches may still follow (one undo step for a burst of them).
     pub fn wheel_busy(&self) -> bool {
-        self.last_wheel.is_some_and(|t| t.elapsed() < Duration::from_millis(600))
+        self.last_wheel
+            .is_some_and(|t| t.elapsed() < Duration::from_millis(600))
     }
 
     /// The gizmo for the document's selection in this view.
@@ -129,7 +140,13 @@ impl ViewTools {
     ) -> bool {
         let gizmo = Self::gizmo(doc, view, axes);
         let (pos, press_origin, any_down, modifiers, esc) = ui.input(|i| {
-            (i.pointer.interact_pos(), i.pointer.press_origin(), i.pointer.any_down(), i.modifiers, i.key_pressed(egui::Key::Escape))
+            (
+                i.pointer.interact_pos(),
+                i.pointer.press_origin(),
+                i.pointer.any_down(),
+                i.modifiers,
+                i.key_pressed(egui::Key::Escape),
+            )
         });
         if !any_down {
             self.cancelled = false;
@@ -155,10 +172,19 @@ impl ViewTools {
                     .and_then(|g| g.pick(view, origin).and_then(|h| g.grab(view, h, origin)))
                     .map(Tool::Gizmo)
             } else if (middle && modifiers.shift) || (primary && modifiers.alt && modifiers.shift) {
-                let depth = view.basis.depth(under.unwrap_or_else(|| fallback_pivot(doc)));
-                Some(Tool::Pan { camera, basis: view.basis, depth })
+                let depth = view
+                    .basis
+                    .depth(under.unwrap_or_else(|| fallback_pivot(doc)));
+                Some(Tool::Pan {
+                    camera,
+                    basis: view.basis,
+                    depth,
+                })
             } else if middle || (primary && modifiers.alt) {
-                Some(Tool::Orbit { camera, pivot: under.unwrap_or_else(|| fallback_pivot(doc)) })
+                Some(Tool::Orbit {
+                    camera,
+                    pivot: under.unwrap_or_else(|| fallback_pivot(doc)),
+                })
             } else {
                 None
             };
@@ -166,7 +192,13 @@ impl ViewTools {
                 if let Tool::Gizmo(g) = &tool {
                     self.hot = Some(g.handle);
                 }
-                self.drag = Some(Drag { tool, origin, mark: doc.history_mark(), last_pos: origin, cell });
+                self.drag = Some(Drag {
+                    tool,
+                    origin,
+                    mark: doc.history_mark(),
+                    last_pos: origin,
+                    cell,
+                });
             }
         }
         if let Some(drag) = self.drag.as_mut().filter(|d| d.cell == cell) {
@@ -191,13 +223,30 @@ impl ViewTools {
                     Tool::Orbit { camera, pivot } => {
                         let k = navigation::ORBIT_DEGREES_PER_POINT;
                         // Grab the scene: dragging right turns its near side right.
-                        Some(Edit::SetCamera(navigation::orbit(camera, *pivot, -d.x * k, -d.y * k)))
+                        Some(Edit::SetCamera(navigation::orbit(
+                            camera,
+                            *pivot,
+                            -d.x * k,
+                            -d.y * k,
+                        )))
                     }
-                    Tool::Pan { camera, basis, depth } => {
+                    Tool::Pan {
+                        camera,
+                        basis,
+                        depth,
+                    } => {
                         let ppp = view.pixels_per_point();
-                        Some(Edit::SetCamera(navigation::pan(camera, basis, *depth, d.x * ppp, d.y * ppp)))
+                        Some(Edit::SetCamera(navigation::pan(
+                            camera,
+                            basis,
+                            *depth,
+                            d.x * ppp,
+                            d.y * ppp,
+                        )))
                     }
-                    Tool::Gizmo(g) => g.value(view, p, modifiers.command).map(|op| Edit::SetOpOfKind { node: g.node, op }),
+                    Tool::Gizmo(g) => g
+                        .value(view, p, modifiers.command)
+                        .map(|op| Edit::SetOpOfKind { node: g.node, op }),
                 };
                 out.extend(edit.map(AppCommand::Edit));
             }
@@ -207,7 +256,11 @@ impl ViewTools {
             return used;
         }
         // The wheel, over the image.
-        let notches = if resp.hovered() { wheel_notches(ui) } else { 0.0 };
+        let notches = if resp.hovered() {
+            wheel_notches(ui)
+        } else {
+            0.0
+        };
         if notches != 0.0 {
             let at = pos.unwrap_or(view.rect.center());
             let burst = self.wheel_toward.filter(|_| self.wheel_busy());
@@ -219,7 +272,11 @@ impl ViewTools {
             });
             self.wheel_toward = Some(toward);
             self.last_wheel = Some(Instant::now());
-            out.push(AppCommand::Edit(Edit::SetCamera(navigation::zoom(&doc.scene.camera, toward, notches))));
+            out.push(AppCommand::Edit(Edit::SetCamera(navigation::zoom(
+                &doc.scene.camera,
+                toward,
+                notches,
+            ))));
             used = true;
         }
         used

@@ -185,12 +185,19 @@ mod unnamed {
             .map_or(0, |d| d.as_nanos());
         for attempt in 0..100u32 {
             let temp = format!(".tracelab-{}-{stamp:x}-{attempt}.tmp", std::process::id());
-            let linked =
-                rustix::fs::linkat(CWD, proc_path.as_str(), folder, temp.as_str(), AtFlags::SYMLINK_FOLLOW)
-                    .or_else(|e| match e {
-                        Errno::NOENT => rustix::fs::linkat(file, "", folder, temp.as_str(), AtFlags::EMPTY_PATH),
-                        e => Err(e),
-                    });
+            let linked = rustix::fs::linkat(
+                CWD,
+                proc_path.as_str(),
+                folder,
+                temp.as_str(),
+                AtFlags::SYMLINK_FOLLOW,
+            )
+            .or_else(|e| match e {
+                Errno::NOENT => {
+                    rustix::fs::linkat(file, "", folder, temp.as_str(), AtFlags::EMPTY_PATH)
+                }
+                e => Err(e),
+            });
             match linked {
                 Ok(()) => return Some(Ok(temp)),
                 Err(Errno::EXIST) => continue,
@@ -295,7 +302,8 @@ mod tests {
         let d = temp_dir("owner");
         let p = d.join("theirs.txt");
         std::fs::write(&p, "old").expect("write");
-        std::os::unix::fs::chown(&p, Some(65534), Some(65534)).expect("chown: this test needs root");
+        std::os::unix::fs::chown(&p, Some(65534), Some(65534))
+            .expect("chown: this test needs root");
         write_atomic(&p, b"new").expect("replace");
         let m = std::fs::metadata(&p).expect("meta");
         assert_eq!((m.uid(), m.gid()), (65534, 65534));
@@ -415,5 +423,4 @@ mod tests {
                 .is_fifo()
         );
     }
-
 }

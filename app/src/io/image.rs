@@ -12,9 +12,15 @@ pub enum ImageWriteError {
     #[error("{}: unknown image format (use .png, .tga, .ppm or .bmp)", .0.display())]
     UnknownFormat(std::path::PathBuf),
     #[error("{}: cannot encode image: {source}", .path.display())]
-    Encode { path: std::path::PathBuf, source: image::ImageError },
+    Encode {
+        path: std::path::PathBuf,
+        source: image::ImageError,
+    },
     #[error("{}: cannot write image: {source}", .path.display())]
-    Write { path: std::path::PathBuf, source: std::io::Error },
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// Encodes one view of a frame in the format its extension names (see [`image_format`]),
@@ -28,7 +34,8 @@ pub fn write_image(
 ) -> Result<(), ImageWriteError> {
     let p = || path.to_path_buf();
     let format = image_format(path).ok_or_else(|| ImageWriteError::UnknownFormat(p()))?;
-    let bytes = encode_image(frame, view, depth, format).map_err(|source| ImageWriteError::Encode { path: p(), source })?;
+    let bytes = encode_image(frame, view, depth, format)
+        .map_err(|source| ImageWriteError::Encode { path: p(), source })?;
     write_atomic(path, &bytes).map_err(|source| ImageWriteError::Write { path: p(), source })
 }
 

@@ -40,10 +40,18 @@ pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
     let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
     let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
     let outcome = match out.scene {
-        Some(scene) => Ok(Opened { scene, messages, lost_comments }),
+        Some(scene) => Ok(Opened {
+            scene,
+            messages,
+            lost_comments,
+        }),
         None => Err(messages),
     };
-    SceneRead { path: path.to_path_buf(), outcome, cache }
+    SceneRead {
+        path: path.to_path_buf(),
+        outcome,
+        cache,
+    }
 }
 
 /// Reads a scene (`None`: the built-in one) for the command line, printing its warnings to
@@ -52,7 +60,12 @@ pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
     let mut cache = MeshCache::new();
     let outcome = match path {
         Some(p) => tracelab_core::load_scene(p, &mut cache),
-        None => tracelab_core::parse_scene(crate::DEFAULT_SCENE.as_bytes(), crate::DEFAULT_SCENE_NAME, None, &mut cache),
+        None => tracelab_core::parse_scene(
+            crate::DEFAULT_SCENE.as_bytes(),
+            crate::DEFAULT_SCENE_NAME,
+            None,
+            &mut cache,
+        ),
     };
     warn_or_fail(outcome)
 }

@@ -28,7 +28,10 @@ pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>
             h.step();
             return;
         }
-        assert!(start.elapsed() < std::time::Duration::from_secs(60), "render did not finish");
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "render did not finish"
+        );
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
 }

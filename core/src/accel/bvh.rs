@@ -206,14 +206,22 @@ impl Bvh {
                 let node = &self.nodes[idx as usize];
                 if node.is_leaf() {
                     let first = node.right_or_first as usize;
-                    for &p in self.indices.get(first..first + node.count as usize).unwrap_or(&[]) {
+                    for &p in self
+                        .indices
+                        .get(first..first + node.count as usize)
+                        .unwrap_or(&[])
+                    {
                         leaf(p, lanes, t);
                     }
                 } else {
                     let (l, r) = (idx + 1, node.right_or_first);
                     let (ml, nl) = test(l, lanes, t);
                     let (mr, nr) = test(r, lanes, t);
-                    let ((near, mn), (far, mf)) = if nl <= nr { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+                    let ((near, mn), (far, mf)) = if nl <= nr {
+                        ((l, ml), (r, mr))
+                    } else {
+                        ((r, mr), (l, ml))
+                    };
                     if mn != 0 && mf != 0 && sp < stack.len() {
                         stack[sp] = (far, mf);
                         sp += 1;
@@ -391,7 +399,14 @@ mod tests {
         let b = boxes(3000);
         let bvh = Bvh::build(&b);
         let entry = |p: u32, o: Vec3A, d: Vec3A, t_max: f32| {
-            let (near, far) = crate::accel::slab::span(b[p as usize].min.into(), b[p as usize].max.into(), o, d.recip(), 1e-3, t_max);
+            let (near, far) = crate::accel::slab::span(
+                b[p as usize].min.into(),
+                b[p as usize].max.into(),
+                o,
+                d.recip(),
+                1e-3,
+                t_max,
+            );
             (near <= far && near < t_max).then_some(near)
         };
         let mut s = 0x2545_f491u32;
@@ -408,7 +423,9 @@ mod tests {
             let spread = if packet % 3 == 0 { 2.0 } else { 0.05 };
             let base = Vec3A::new(rnd() - 0.5, rnd() - 0.5, 1.0);
             let o = [eye; 8];
-            let d: [Vec3A; 8] = std::array::from_fn(|_| base + Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * spread);
+            let d: [Vec3A; 8] = std::array::from_fn(|_| {
+                base + Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * spread
+            });
             let active = [0xffu8, 0x5a, 0x81, 0x01][packet % 4];
             let mut t = [f32::INFINITY; 8];
             bvh.traverse8(&o, &d, active, 1e-3, &mut t, |p, lanes, t| {
@@ -423,7 +440,9 @@ mod tests {
             });
             for k in 0..8 {
                 let want = if active & (1 << k) != 0 {
-                    bvh.traverse(o[k].into(), d[k].into(), 1e-3, f32::INFINITY, |p, t_max| entry(p, o[k], d[k], t_max))
+                    bvh.traverse(o[k].into(), d[k].into(), 1e-3, f32::INFINITY, |p, t_max| {
+                        entry(p, o[k], d[k], t_max)
+                    })
                 } else {
                     f32::INFINITY
                 };

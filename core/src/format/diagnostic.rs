@@ -25,7 +25,10 @@ pub struct Diagnostic {
 /// and bidirectional overrides are written as escapes, so a message cannot drive the terminal
 /// or reorder what it shows.
 pub fn escape_controls(s: &str) -> Cow<'_, str> {
-    let unsafe_char = |c: char| c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    let unsafe_char = |c: char| {
+        c.is_control()
+            || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+    };
     if !s.chars().any(unsafe_char) {
         return Cow::Borrowed(s);
     }
@@ -101,15 +104,27 @@ pub struct SourceFile<'a> {
 
 impl<'a> SourceFile<'a> {
     pub fn new(name: &'a str, text: &'a str) -> Self {
-        SourceFile { name, text, line_starts: std::cell::OnceCell::new(), cursor: Cell::new((0, 0, 0)) }
+        SourceFile {
+            name,
+            text,
+            line_starts: std::cell::OnceCell::new(),
+            cursor: Cell::new((0, 0, 0)),
+        }
     }
 
     fn line_starts(&self) -> &[u32] {
         self.line_starts.get_or_init(|| {
             // Offsets past 4 GiB (never a scene file: those are capped far below) are left
             // out, so such lines count as part of the last line listed.
-            let newline = |(i, &b): (usize, &u8)| (b == b'\n').then(|| u32::try_from(i + 1).ok()).flatten();
-            let n = self.text.as_bytes().iter().enumerate().filter_map(newline).count();
+            let newline =
+                |(i, &b): (usize, &u8)| (b == b'\n').then(|| u32::try_from(i + 1).ok()).flatten();
+            let n = self
+                .text
+                .as_bytes()
+                .iter()
+                .enumerate()
+                .filter_map(newline)
+                .count();
             let mut v = Vec::with_capacity(n + 1);
             v.push(0);
             v.extend(self.text.as_bytes().iter().enumerate().filter_map(newline));
@@ -121,27 +136,46 @@ impl<'a> SourceFile<'a> {
     pub fn line_col(&self, offset: usize) -> (u32, u32) {
         let offset = offset.min(self.text.len());
         let starts = self.line_starts();
-        let line = starts.partition_point(|&s| s as usize <= offset).saturating_sub(1);
+        let line = starts
+            .partition_point(|&s| s as usize <= offset)
+            .saturating_sub(1);
         let (c_line, c_off, c_col) = self.cursor.get();
         let (from, base) = if c_line == line && c_off <= offset {
             (c_off, c_col)
         } else {
             (starts.get(line).map_or(0, |&s| s as usize), 0)
         };
-        let counted = self.text.get(from..offset).map_or(offset - from, |s| s.chars().count());
+        let counted = self
+            .text
+            .get(from..offset)
+            .map_or(offset - from, |s| s.chars().count());
         let col = base.saturating_add(u32::try_from(counted).unwrap_or(u32::MAX));
         self.cursor.set((line, offset, col));
-        (u32::try_from(line + 1).unwrap_or(u32::MAX), col.saturating_add(1))
+        (
+            u32::try_from(line + 1).unwrap_or(u32::MAX),
+            col.saturating_add(1),
+        )
     }
 
-    pub fn diagnostic(&self, severity: Severity, offset: usize, message: impl Into<String>) -> Diagnostic {
+    pub fn diagnostic(
+        &self,
+        severity: Severity,
+        offset: usize,
+        message: impl Into<String>,
+    ) -> Diagnostic {
         let (line, col) = self.line_col(offset);
         let message = message.into();
         let message = match escape_controls(&message) {
             Cow::Borrowed(_) => message,
             Cow::Owned(escaped) => escaped,
         };
-        Diagnostic { severity, file: self.name.to_string(), line, col, message }
+        Diagnostic {
+            severity,
+            file: self.name.to_string(),
+            line,
+            col,
+            message,
+        }
     }
 }
 
@@ -161,7 +195,10 @@ mod tests {
     #[test]
     fn control_characters_are_escaped_and_other_text_kept() {
         assert_eq!(escape_controls("plain é ✓"), "plain é ✓");
-        assert_eq!(escape_controls("a\u{1b}[31mb\u{b}c\u{7f}\u{202e}d\u{85}"), "a\\x1b[31mb\\x0bc\\x7f\\u{202e}d\\u{85}");
+        assert_eq!(
+            escape_controls("a\u{1b}[31mb\u{b}c\u{7f}\u{202e}d\u{85}"),
+            "a\\x1b[31mb\\x0bc\\x7f\\u{202e}d\\u{85}"
+        );
         // Escaping twice changes nothing more.
         let once = escape_controls("\u{1b}x").into_owned();
         assert_eq!(escape_controls(&once), once);
@@ -171,7 +208,9 @@ mod tests {
     fn lookups_in_any_order_agree_with_counting_from_the_line_start() {
         let text = "aé b\nçç ç\n\nxyz";
         let s = SourceFile::new("f", text);
-        let offsets: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        let offsets: Vec<usize> = (0..=text.len())
+            .filter(|&i| text.is_char_boundary(i))
+            .collect();
         let expected: Vec<(u32, u32)> = offsets
             .iter()
             .map(|&o| {

@@ -42,17 +42,36 @@ pub fn tokenize_with_comments(text: &str) -> (Vec<Token>, Vec<Comment>) {
             }
             // Trimming ASCII whitespace keeps `end` on a char boundary.
             let end = start + text[start..i].trim_end().len();
-            comments.push(Comment { start, end, next_token: out.len() });
+            comments.push(Comment {
+                start,
+                end,
+                next_token: out.len(),
+            });
         } else if c == b'{' || c == b'}' {
-            let kind = if c == b'{' { TokKind::Open } else { TokKind::Close };
-            out.push(Token { kind, start: i, end: i + 1 });
+            let kind = if c == b'{' {
+                TokKind::Open
+            } else {
+                TokKind::Close
+            };
+            out.push(Token {
+                kind,
+                start: i,
+                end: i + 1,
+            });
             i += 1;
         } else {
             let start = i;
-            while i < bytes.len() && !bytes[i].is_ascii_whitespace() && !matches!(bytes[i], b'{' | b'}' | b'#') {
+            while i < bytes.len()
+                && !bytes[i].is_ascii_whitespace()
+                && !matches!(bytes[i], b'{' | b'}' | b'#')
+            {
                 i += 1;
             }
-            out.push(Token { kind: TokKind::Word, start, end: i });
+            out.push(Token {
+                kind: TokKind::Word,
+                start,
+                end: i,
+            });
         }
     }
     (out, comments)
@@ -65,15 +84,25 @@ mod tests {
     #[test]
     fn braces_split_from_words_and_comments_skipped() {
         let src = "Sphere{center 1 2 3 # note\n radius 1}";
-        let toks: Vec<&str> = tokenize_with_comments(src).0.iter().map(|t| &src[t.start..t.end]).collect();
-        assert_eq!(toks, ["Sphere", "{", "center", "1", "2", "3", "radius", "1", "}"]);
+        let toks: Vec<&str> = tokenize_with_comments(src)
+            .0
+            .iter()
+            .map(|t| &src[t.start..t.end])
+            .collect();
+        assert_eq!(
+            toks,
+            ["Sphere", "{", "center", "1", "2", "3", "radius", "1", "}"]
+        );
     }
 
     #[test]
     fn comments_come_back_with_the_token_they_precede() {
         let src = "# head \r\nA {# in\n}\n#tail";
         let (toks, comments) = tokenize_with_comments(src);
-        let got: Vec<(&str, usize)> = comments.iter().map(|c| (&src[c.start..c.end], c.next_token)).collect();
+        let got: Vec<(&str, usize)> = comments
+            .iter()
+            .map(|c| (&src[c.start..c.end], c.next_token))
+            .collect();
         assert_eq!(got, [(" head", 0), (" in", 2), ("tail", 3)]);
         assert_eq!(toks.len(), 3);
     }

@@ -16,7 +16,12 @@ pub fn load_scene(path: &Path, cache: &mut MeshCache) -> ParseOutcome {
 
 /// Parses scene text and loads its meshes. `name` is used in messages; `base_dir` is where
 /// OBJ files are looked for first (then the current folder).
-pub fn parse_scene(bytes: &[u8], name: &str, base_dir: Option<&Path>, cache: &mut MeshCache) -> ParseOutcome {
+pub fn parse_scene(
+    bytes: &[u8],
+    name: &str,
+    base_dir: Option<&Path>,
+    cache: &mut MeshCache,
+) -> ParseOutcome {
     let mut out = parse_scene_unresolved(bytes, name);
     resolve_meshes(&mut out, base_dir, cache);
     out

@@ -12,9 +12,11 @@ mod token_stream;
 mod writer;
 
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile, escape_controls};
-pub(crate) use parser::is_numberlike;
 pub use load::{load_scene, parse_scene};
-pub use parser::{Located, MAX_SCENE_BYTES, MeshRef, ParseOutcome, load_scene_unresolved, parse_scene_unresolved};
-pub use resolve::resolve_meshes;
+pub(crate) use parser::is_numberlike;
+pub use parser::{
+    Located, MAX_SCENE_BYTES, MeshRef, ParseOutcome, load_scene_unresolved, parse_scene_unresolved,
+};
 pub use rebase::rebase_mesh_paths;
+pub use resolve::resolve_meshes;
 pub use writer::{try_write_scene, uses_only_course_grammar, write_scene};

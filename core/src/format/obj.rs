@@ -36,7 +36,11 @@ pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, 
     let mut candidates = Vec::new();
     if let Some(dir) = base_dir {
         candidates.push(dir.join(name));
-        tried.push(if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
+        tried.push(if dir.as_os_str().is_empty() {
+            ".".to_string()
+        } else {
+            dir.display().to_string()
+        });
     }
     candidates.push(PathBuf::from(name));
     tried.push("the current folder".to_string());
@@ -44,7 +48,12 @@ pub fn resolve_obj_path(name: &str, base_dir: Option<&Path>) -> Result<PathBuf, 
         match file_kind(&p) {
             FileKind::Missing => continue,
             FileKind::Regular => return Ok(p),
-            other => return Err(ObjError::NotAFile { path: p, what: other.describe() }),
+            other => {
+                return Err(ObjError::NotAFile {
+                    path: p,
+                    what: other.describe(),
+                });
+            }
         }
     }
     Err(ObjError::NotFound { tried })
@@ -78,7 +87,10 @@ pub enum MeshEvent<'a> {
 
 impl std::fmt::Debug for MeshCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("MeshCache").field("meshes", &self.meshes.len()).field("observed", &self.observer.is_some()).finish()
+        f.debug_struct("MeshCache")
+            .field("meshes", &self.meshes.len())
+            .field("observed", &self.observer.is_some())
+            .finish()
     }
 }
 
@@ -104,7 +116,10 @@ impl MeshCache {
         let observer = self.observer.clone();
         let go_on = |e: MeshEvent<'_>| observer.as_ref().is_none_or(|o| o(e));
         let loaded = (|| {
-            if !go_on(MeshEvent::Reading { path: &canon, bytes: meta.len() }) {
+            if !go_on(MeshEvent::Reading {
+                path: &canon,
+                bytes: meta.len(),
+            }) {
                 return Err(ObjError::Cancelled);
             }
             let bytes = read_obj_bytes(&canon)?;
@@ -113,7 +128,10 @@ impl MeshCache {
             }
             let (positions, triangles) = parse_obj_triangles(&bytes, &file_name(&canon))?;
             drop(bytes);
-            if !go_on(MeshEvent::Building { path: &canon, triangles: triangles.len() }) {
+            if !go_on(MeshEvent::Building {
+                path: &canon,
+                triangles: triangles.len(),
+            }) {
                 return Err(ObjError::Cancelled);
             }
             Ok(Mesh::new(positions, triangles))
@@ -132,7 +150,9 @@ impl MeshCache {
 }
 
 fn file_name(path: &Path) -> String {
-    path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default()
+    path.file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default()
 }
 
 /// Reads one OBJ file into a single mesh (all its objects and groups together). Only regular
@@ -147,9 +167,12 @@ fn read_obj_bytes(path: &Path) -> Result<Vec<u8>, ObjError> {
     use std::io::Read as _;
     let file = open_regular(path)?;
     let mut bytes = Vec::new();
-    file.take(MAX_OBJ_BYTES as u64 + 1).read_to_end(&mut bytes)?;
+    file.take(MAX_OBJ_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)?;
     if bytes.len() > MAX_OBJ_BYTES {
-        return Err(ObjError::TooLarge { limit_mib: MAX_OBJ_BYTES >> 20 });
+        return Err(ObjError::TooLarge {
+            limit_mib: MAX_OBJ_BYTES >> 20,
+        });
     }
     Ok(bytes)
 }
@@ -182,23 +205,38 @@ pub fn parse_obj_fast(bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
 /// `mtllib` files are never opened: tracelab shades with the scene's materials, and a
 /// material library could be a FIFO or a device.
 pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
-    let opts = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
     let no_materials = |_: &Path| -> tobj::MTLLoadResult { Err(tobj::LoadError::OpenFileFailed) };
     let (models, _materials) = match tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials) {
         Ok(r) => r,
-        Err(e) => return Err(ObjError::Syntax(locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string()))),
+        Err(e) => {
+            return Err(ObjError::Syntax(
+                locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string()),
+            ));
+        }
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     for m in &models {
         let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        positions.extend(
+            m.mesh
+                .positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
         let nv = positions.len() as u32;
         for t in m.mesh.indices.chunks_exact(3) {
             let tri = [t[0] + base, t[1] + base, t[2] + base];
             if tri.iter().any(|&i| i >= nv) {
                 return Err(ObjError::Syntax(
-                    locate_obj_error(bytes, name).unwrap_or_else(|| "a face refers to a vertex that does not exist".into()),
+                    locate_obj_error(bytes, name)
+                        .unwrap_or_else(|| "a face refers to a vertex that does not exist".into()),
                 ));
             }
             triangles.push(tri);
@@ -306,11 +344,15 @@ mod tests {
                 MeshEvent::Done { .. } => "done".into(),
             };
             s.lock().expect("lock").push(step);
-            !(stop.load(std::sync::atomic::Ordering::Relaxed) && matches!(e, MeshEvent::Building { .. }))
+            !(stop.load(std::sync::atomic::Ordering::Relaxed)
+                && matches!(e, MeshEvent::Building { .. }))
         })));
         assert_eq!(cache.load(&p).expect_err("stopped"), ObjError::Cancelled);
         let reading = format!("reading {}", text.len());
-        assert_eq!(*seen.lock().expect("lock"), [reading.as_str(), "parsing", "building 2", "done"]);
+        assert_eq!(
+            *seen.lock().expect("lock"),
+            [reading.as_str(), "parsing", "building 2", "done"]
+        );
         // A stopped load caches nothing: the next one reads the file again.
         stop_at_build.store(false, std::sync::atomic::Ordering::Relaxed);
         seen.lock().expect("lock").clear();
@@ -372,7 +414,11 @@ mod tests {
     #[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
     fn fast_reader_matches_tobj_on_the_shared_meshes() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
-        assert!(dir.is_dir(), "{} is missing: this test needs ../shared beside the checkout", dir.display());
+        assert!(
+            dir.is_dir(),
+            "{} is missing: this test needs ../shared beside the checkout",
+            dir.display()
+        );
         // The dragon takes tobj seconds in a debug build; the smaller meshes cover the format.
         for name in ["cube.obj", "bunny_1k.obj", "stanford-bunny.obj"] {
             same_geometry(&dir.join(name));

@@ -13,8 +13,8 @@ use super::lexer::{TokKind, Token};
 use super::token_stream::TokenStream;
 
 use crate::scene::{
-    Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot, Node,
-    NodeId, NodeKind, Scene, SceneComments, TransformOp, validate,
+    Anchor, Background, Camera, Comments, CsgOp, Graph, Light, Material, MaterialKeyword, MeshSlot,
+    Node, NodeId, NodeKind, Scene, SceneComments, TransformOp, validate,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -73,14 +73,23 @@ pub fn load_scene_unresolved(path: &Path) -> ParseOutcome {
     let name = path.display().to_string();
     let whole_file_error = |message: String| ParseOutcome {
         scene: None,
-        diagnostics: Diagnostics(vec![Diagnostic { severity: Severity::Error, file: name.clone(), line: 0, col: 0, message }]),
+        diagnostics: Diagnostics(vec![Diagnostic {
+            severity: Severity::Error,
+            file: name.clone(),
+            line: 0,
+            col: 0,
+            message,
+        }]),
         lost_comments: Vec::new(),
         meshes: Vec::new(),
         unshown: UnshownSummary::default(),
     };
     match read_capped(path, MAX_SCENE_BYTES) {
         Ok(Some(bytes)) => parse_scene_unresolved(&bytes, &name),
-        Ok(None) => whole_file_error(format!("the file is larger than {} MiB, the most tracelab reads as a scene", MAX_SCENE_BYTES >> 20)),
+        Ok(None) => whole_file_error(format!(
+            "the file is larger than {} MiB, the most tracelab reads as a scene",
+            MAX_SCENE_BYTES >> 20
+        )),
         Err(e) => whole_file_error(format!("cannot read scene file: {e}")),
     }
 }
@@ -105,7 +114,10 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
                 Ok(t) => (t.find('\0').unwrap_or(0), "a NUL byte".to_string()),
                 Err(e) => {
                     let b = bytes.get(e.valid_up_to()).copied().unwrap_or(0);
-                    (e.valid_up_to(), format!("byte 0x{b:02x}, which is not UTF-8 text"))
+                    (
+                        e.valid_up_to(),
+                        format!("byte 0x{b:02x}, which is not UTF-8 text"),
+                    )
                 }
             };
             let prefix = std::str::from_utf8(&bytes[..valid_up_to]).unwrap_or("");
@@ -285,9 +297,16 @@ const OBJECT_KEYWORDS: &[&str] = &[
 
 /// An item's comments: those before its keyword, before each field, and before its `}`.
 fn block_comments(before: Vec<String>, fields: &mut [Field], end: Vec<String>) -> Comments {
-    let mut c = Comments { before, end, ..Comments::default() };
+    let mut c = Comments {
+        before,
+        end,
+        ..Comments::default()
+    };
     for f in fields.iter_mut().filter(|f| !f.comments.is_empty()) {
-        c.inner.entry(Anchor::Field(f.name.clone())).or_default().append(&mut f.comments);
+        c.inner
+            .entry(Anchor::Field(f.name.clone()))
+            .or_default()
+            .append(&mut f.comments);
     }
     c
 }
@@ -297,7 +316,9 @@ pub(crate) fn is_numberlike(s: &str) -> bool {
     let first = s.as_bytes().first().copied().unwrap_or(b'a');
     first.is_ascii_digit()
         || matches!(first, b'-' | b'+' | b'.')
-        || ["nan", "inf", "infinity"].iter().any(|k| s.eq_ignore_ascii_case(k))
+        || ["nan", "inf", "infinity"]
+            .iter()
+            .any(|k| s.eq_ignore_ascii_case(k))
 }
 
 impl<'a> Parser<'a> {
@@ -361,7 +382,9 @@ impl<'a> Parser<'a> {
     fn word_at(&self, offset: usize) -> &'a str {
         let text: &'a str = self.src.text;
         let rest = text.get(offset..).unwrap_or("");
-        let end = rest.find(|c: char| c.is_ascii_whitespace() || matches!(c, '{' | '}' | '#')).unwrap_or(rest.len());
+        let end = rest
+            .find(|c: char| c.is_ascii_whitespace() || matches!(c, '{' | '}' | '#'))
+            .unwrap_or(rest.len());
         &rest[..end]
     }
 
@@ -404,11 +427,20 @@ impl<'a> Parser<'a> {
     fn summarise_unshown(&mut self) -> UnshownSummary {
         let u = &self.unshown;
         let mut out = UnshownSummary::default();
-        for (severity, (n, at), what) in [(Severity::Error, u.errors, "error"), (Severity::Warning, u.warnings, "warning")] {
+        for (severity, (n, at), what) in [
+            (Severity::Error, u.errors, "error"),
+            (Severity::Warning, u.warnings, "warning"),
+        ] {
             if n > 0 {
                 let s = if n == 1 { "" } else { "s" };
-                let d = self.src.diagnostic(severity, at, format!("… and {n} more {what}{s}"));
-                let place = Some(Located { file: d.file.clone(), line: d.line, col: d.col });
+                let d = self
+                    .src
+                    .diagnostic(severity, at, format!("… and {n} more {what}{s}"));
+                let place = Some(Located {
+                    file: d.file.clone(),
+                    line: d.line,
+                    col: d.col,
+                });
                 match severity {
                     Severity::Error => out.errors = (n, place),
                     Severity::Warning => out.warnings = (n, place),
@@ -446,7 +478,10 @@ impl<'a> Parser<'a> {
             }
             other => {
                 let (found, off) = self.describe(other);
-                self.error(off, format!("expected \"{{\" after \"{keyword}\", found {found}"));
+                self.error(
+                    off,
+                    format!("expected \"{{\" after \"{keyword}\", found {found}"),
+                );
                 None
             }
         }
@@ -462,13 +497,19 @@ impl<'a> Parser<'a> {
             }
             if is_numberlike(self.text(t)) {
                 self.pos += 1;
-                let msg = format!("expected a whole number after \"{keyword}\", found \"{}\"", self.text(t));
+                let msg = format!(
+                    "expected a whole number after \"{keyword}\", found \"{}\"",
+                    self.text(t)
+                );
                 self.error(t.start, msg);
                 return None;
             }
         }
         let (found, off) = self.describe(t);
-        self.error(off, format!("expected a whole number after \"{keyword}\", found {found}"));
+        self.error(
+            off,
+            format!("expected a whole number after \"{keyword}\", found {found}"),
+        );
         None
     }
 
@@ -478,11 +519,17 @@ impl<'a> Parser<'a> {
         match s.parse::<f32>() {
             Ok(v) if v.is_finite() => Some(v),
             Ok(_) => {
-                self.error(t.start, format!("\"{s}\" after \"{after}\" is not a finite number"));
+                self.error(
+                    t.start,
+                    format!("\"{s}\" after \"{after}\" is not a finite number"),
+                );
                 None
             }
             Err(_) => {
-                self.error(t.start, format!("expected a number after \"{after}\", found \"{s}\""));
+                self.error(
+                    t.start,
+                    format!("expected a number after \"{after}\", found \"{s}\""),
+                );
                 None
             }
         }
@@ -500,8 +547,15 @@ impl<'a> Parser<'a> {
                 }
                 other => {
                     let (found, off) = self.describe(other);
-                    let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
-                    self.error(off, format!("expected {what} after \"{keyword}\", found {found}"));
+                    let what = if n == 1 {
+                        "a number".to_string()
+                    } else {
+                        format!("{n} numbers")
+                    };
+                    self.error(
+                        off,
+                        format!("expected {what} after \"{keyword}\", found {found}"),
+                    );
                     return None;
                 }
             }
@@ -519,7 +573,12 @@ impl<'a> Parser<'a> {
         let end_comments;
         loop {
             let Some(t) = self.next() else {
-                self.error(open, format!("unterminated {block} block: expected \"}}\" before the end of the file"));
+                self.error(
+                    open,
+                    format!(
+                        "unterminated {block} block: expected \"}}\" before the end of the file"
+                    ),
+                );
                 return None;
             };
             match t.kind {
@@ -538,7 +597,10 @@ impl<'a> Parser<'a> {
                         if ok {
                             let msg = match fields.last() {
                                 Some(f) if f.values.is_empty() && f.word.is_none() => {
-                                    format!("expected a number after \"{}\", found \"{name}\"", f.name)
+                                    format!(
+                                        "expected a number after \"{}\", found \"{name}\"",
+                                        f.name
+                                    )
                                 }
                                 _ => format!("unexpected number \"{name}\" in {block}"),
                             };
@@ -566,7 +628,12 @@ impl<'a> Parser<'a> {
                             }
                             other => {
                                 let (found, off) = self.describe(other);
-                                self.error(off, format!("expected a file name after \"obj_file\", found {found}"));
+                                self.error(
+                                    off,
+                                    format!(
+                                        "expected a file name after \"obj_file\", found {found}"
+                                    ),
+                                );
                                 ok = false;
                             }
                         }
@@ -588,7 +655,10 @@ impl<'a> Parser<'a> {
                             }
                         }
                         if let Some(off) = too_many {
-                            self.error(off, format!("\"{name}\" takes at most {MAX_FIELD_NUMBERS} numbers"));
+                            self.error(
+                                off,
+                                format!("\"{name}\" takes at most {MAX_FIELD_NUMBERS} numbers"),
+                            );
                             ok = false;
                         }
                     }
@@ -601,8 +671,18 @@ impl<'a> Parser<'a> {
     }
 
     /// Takes field `name` with exactly `n` numbers; reports what is wrong otherwise.
-    fn take(&mut self, fields: &mut [Field], block: &str, block_off: usize, name: &str, n: usize) -> Option<Vec<f32>> {
-        let Some(i) = fields.iter().position(|f| f.name == name && (!f.used || f.swallowed)) else {
+    fn take(
+        &mut self,
+        fields: &mut [Field],
+        block: &str,
+        block_off: usize,
+        name: &str,
+        n: usize,
+    ) -> Option<Vec<f32>> {
+        let Some(i) = fields
+            .iter()
+            .position(|f| f.name == name && (!f.used || f.swallowed))
+        else {
             self.error(block_off, format!("{block} is missing \"{name}\""));
             return None;
         };
@@ -610,7 +690,11 @@ impl<'a> Parser<'a> {
         fields[i].swallowed = false;
         let f = &fields[i];
         if f.values.len() < n {
-            let what = if n == 1 { "a number".to_string() } else { format!("{n} numbers") };
+            let what = if n == 1 {
+                "a number".to_string()
+            } else {
+                format!("{n} numbers")
+            };
             let (found, off) = f.after.clone();
             // The word found instead of a number is not a field of its own: do not report
             // it again as unknown.
@@ -618,23 +702,42 @@ impl<'a> Parser<'a> {
                 next.used = true;
                 next.swallowed = true;
             }
-            self.error(off, format!("expected {what} after \"{name}\", found {found}"));
+            self.error(
+                off,
+                format!("expected {what} after \"{name}\", found {found}"),
+            );
             return None;
         }
         if f.values.len() > n {
             let off = f.values[n].1;
             let extra = self.word_at(off);
-            self.error(off, format!("\"{name}\" takes {n} number(s); found an extra \"{extra}\""));
+            self.error(
+                off,
+                format!("\"{name}\" takes {n} number(s); found an extra \"{extra}\""),
+            );
             return None;
         }
         Some(f.values.iter().map(|v| v.0).collect())
     }
 
-    fn take_vec3(&mut self, fields: &mut [Field], block: &str, off: usize, name: &str) -> Option<Vec3> {
-        self.take(fields, block, off, name, 3).map(|v| Vec3::new(v[0], v[1], v[2]))
+    fn take_vec3(
+        &mut self,
+        fields: &mut [Field],
+        block: &str,
+        off: usize,
+        name: &str,
+    ) -> Option<Vec3> {
+        self.take(fields, block, off, name, 3)
+            .map(|v| Vec3::new(v[0], v[1], v[2]))
     }
 
-    fn take_f32(&mut self, fields: &mut [Field], block: &str, off: usize, name: &str) -> Option<f32> {
+    fn take_f32(
+        &mut self,
+        fields: &mut [Field],
+        block: &str,
+        off: usize,
+        name: &str,
+    ) -> Option<f32> {
         self.take(fields, block, off, name, 1).map(|v| v[0])
     }
 
@@ -646,7 +749,10 @@ impl<'a> Parser<'a> {
             let msg = if repeated {
                 format!("\"{}\" is given twice in {block}", f.name)
             } else {
-                format!("unknown field \"{}\" in {block} (expected {expected})", f.name)
+                format!(
+                    "unknown field \"{}\" in {block} (expected {expected})",
+                    f.name
+                )
             };
             self.error(f.name_off, msg);
             ok = false;
@@ -698,8 +804,12 @@ impl<'a> Parser<'a> {
 
     fn parse_camera(&mut self, kw: &str, off: usize) {
         let before = self.comments_here();
-        let Some(open) = self.expect_open(kw) else { return };
-        let Some((mut f, end)) = self.read_fields(kw, open) else { return };
+        let Some(open) = self.expect_open(kw) else {
+            return;
+        };
+        let Some((mut f, end)) = self.read_fields(kw, open) else {
+            return;
+        };
         self.scene_comments.camera = block_comments(before, &mut f, end);
         if self.camera.is_some() {
             self.error(off, "a scene has one camera; this is a second");
@@ -711,13 +821,25 @@ impl<'a> Parser<'a> {
         let last = if perspective { "angle" } else { "size" };
         let extent = self.take_f32(&mut f, kw, off, last);
         self.reject_unused(&f, kw, &format!("center, direction, up, {last}"));
-        let (Some(center), Some(direction), Some(up), Some(extent)) = (center, direction, up, extent) else {
+        let (Some(center), Some(direction), Some(up), Some(extent)) =
+            (center, direction, up, extent)
+        else {
             return;
         };
         let camera = if perspective {
-            Camera::Perspective { center, direction, up, angle: extent }
+            Camera::Perspective {
+                center,
+                direction,
+                up,
+                angle: extent,
+            }
         } else {
-            Camera::Orthographic { center, direction, up, size: extent }
+            Camera::Orthographic {
+                center,
+                direction,
+                up,
+                size: extent,
+            }
         };
         if let Err(e) = validate::check_camera(&camera) {
             self.error(off, e.message);
@@ -728,8 +850,12 @@ impl<'a> Parser<'a> {
 
     fn parse_background(&mut self, off: usize) {
         let before = self.comments_here();
-        let Some(open) = self.expect_open("Background") else { return };
-        let Some((mut f, end)) = self.read_fields("Background", open) else { return };
+        let Some(open) = self.expect_open("Background") else {
+            return;
+        };
+        let Some((mut f, end)) = self.read_fields("Background", open) else {
+            return;
+        };
         self.scene_comments.background = block_comments(before, &mut f, end);
         let mut bg = Background::default();
         if f.iter().any(|x| x.name == "color") {
@@ -746,8 +872,13 @@ impl<'a> Parser<'a> {
     }
 
     fn parse_lights(&mut self, off: usize) {
-        let mut comments = Comments { before: self.comments_here(), ..Comments::default() };
-        let Some(open) = self.expect_open("Lights") else { return };
+        let mut comments = Comments {
+            before: self.comments_here(),
+            ..Comments::default()
+        };
+        let Some(open) = self.expect_open("Lights") else {
+            return;
+        };
         if self.lights.is_some() {
             self.error(off, "a scene has one Lights block; this is a second");
         }
@@ -755,7 +886,10 @@ impl<'a> Parser<'a> {
         let mut declared = None;
         loop {
             let Some(t) = self.next() else {
-                self.error(open, "unterminated Lights block: expected \"}\" before the end of the file");
+                self.error(
+                    open,
+                    "unterminated Lights block: expected \"}\" before the end of the file",
+                );
                 return;
             };
             match (t.kind, self.text(t)) {
@@ -766,20 +900,32 @@ impl<'a> Parser<'a> {
                 (TokKind::Word, "numLights") => {
                     let c = self.comments_here();
                     if !c.is_empty() {
-                        comments.inner.entry(Anchor::Field("numLights".into())).or_default().extend(c);
+                        comments
+                            .inner
+                            .entry(Anchor::Field("numLights".into()))
+                            .or_default()
+                            .extend(c);
                     }
                     declared = self.expect_count("numLights")
                 }
                 (TokKind::Word, "DirectionalLight") => {
                     let before = self.comments_here();
-                    let Some(o) = self.expect_open("DirectionalLight") else { continue };
-                    let Some((mut f, end)) = self.read_fields("DirectionalLight", o) else { continue };
+                    let Some(o) = self.expect_open("DirectionalLight") else {
+                        continue;
+                    };
+                    let Some((mut f, end)) = self.read_fields("DirectionalLight", o) else {
+                        continue;
+                    };
                     let light_comments = block_comments(before, &mut f, end);
                     let d = self.take_vec3(&mut f, "DirectionalLight", t.start, "direction");
                     let c = self.take_vec3(&mut f, "DirectionalLight", t.start, "color");
                     self.reject_unused(&f, "DirectionalLight", "direction, color");
                     if let (Some(direction), Some(color)) = (d, c) {
-                        let light = Light { direction, color, comments: light_comments };
+                        let light = Light {
+                            direction,
+                            color,
+                            comments: light_comments,
+                        };
                         if let Err(e) = validate::check_light(&light) {
                             self.error(t.start, e.message);
                         }
@@ -788,7 +934,9 @@ impl<'a> Parser<'a> {
                 }
                 (_, w) => {
                     self.error(t.start, format!("unknown keyword \"{w}\" in Lights (expected numLights or DirectionalLight)"));
-                    if t.kind == TokKind::Open || self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                    if t.kind == TokKind::Open
+                        || self.peek().is_some_and(|n| n.kind == TokKind::Open)
+                    {
                         if t.kind != TokKind::Open {
                             self.pos += 1;
                         }
@@ -798,9 +946,13 @@ impl<'a> Parser<'a> {
             }
         }
         match declared {
-            Some((n, at)) if n != lights.len() => {
-                self.error(at, format!("numLights says {n} but the block holds {} light(s)", lights.len()))
-            }
+            Some((n, at)) if n != lights.len() => self.error(
+                at,
+                format!(
+                    "numLights says {n} but the block holds {} light(s)",
+                    lights.len()
+                ),
+            ),
             None => self.warn(off, "Lights has no numLights; counting the lights instead"),
             _ => {}
         }
@@ -816,7 +968,10 @@ impl<'a> Parser<'a> {
         let mut ok = true;
         for (i, x) in f.iter().enumerate() {
             let msg = if x.word.is_some() {
-                format!("\"{}\" belongs in TriangleMesh, not in {kw} (material fields take numbers)", x.name)
+                format!(
+                    "\"{}\" belongs in TriangleMesh, not in {kw} (material fields take numbers)",
+                    x.name
+                )
             } else if f[..i].iter().any(|y| y.name == x.name) {
                 format!("\"{}\" is given twice in {kw}", x.name)
             } else {
@@ -828,7 +983,11 @@ impl<'a> Parser<'a> {
         if !ok {
             return None;
         }
-        let keyword = if kw == "PhongMaterial" { MaterialKeyword::PhongMaterial } else { MaterialKeyword::Material };
+        let keyword = if kw == "PhongMaterial" {
+            MaterialKeyword::PhongMaterial
+        } else {
+            MaterialKeyword::Material
+        };
         // Other fields (specularColor, exponent, …) are kept, not shaded with.
         let extra = f
             .iter()
@@ -836,17 +995,30 @@ impl<'a> Parser<'a> {
             .map(|x| (x.name.clone(), x.values.iter().map(|v| v.0).collect()))
             .collect();
         let comments = block_comments(before, &mut f, end);
-        Some(Material { diffuse, keyword, extra, comments })
+        Some(Material {
+            diffuse,
+            keyword,
+            extra,
+            comments,
+        })
     }
 
     fn parse_materials(&mut self, off: usize) {
-        let mut comments = Comments { before: self.comments_here(), ..Comments::default() };
-        let Some(open) = self.expect_open("Materials") else { return };
+        let mut comments = Comments {
+            before: self.comments_here(),
+            ..Comments::default()
+        };
+        let Some(open) = self.expect_open("Materials") else {
+            return;
+        };
         let mut declared = None;
         let mut count = 0;
         loop {
             let Some(t) = self.next() else {
-                self.error(open, "unterminated Materials block: expected \"}\" before the end of the file");
+                self.error(
+                    open,
+                    "unterminated Materials block: expected \"}\" before the end of the file",
+                );
                 return;
             };
             match (t.kind, self.text(t)) {
@@ -857,7 +1029,11 @@ impl<'a> Parser<'a> {
                 (TokKind::Word, "numMaterials") => {
                     let c = self.comments_here();
                     if !c.is_empty() {
-                        comments.inner.entry(Anchor::Field("numMaterials".into())).or_default().extend(c);
+                        comments
+                            .inner
+                            .entry(Anchor::Field("numMaterials".into()))
+                            .or_default()
+                            .extend(c);
                     }
                     declared = self.expect_count("numMaterials")
                 }
@@ -872,7 +1048,9 @@ impl<'a> Parser<'a> {
                         t.start,
                         format!("unknown keyword \"{w}\" in Materials (expected numMaterials, Material or PhongMaterial)"),
                     );
-                    if t.kind == TokKind::Open || self.peek().is_some_and(|n| n.kind == TokKind::Open) {
+                    if t.kind == TokKind::Open
+                        || self.peek().is_some_and(|n| n.kind == TokKind::Open)
+                    {
                         if t.kind != TokKind::Open {
                             self.pos += 1;
                         }
@@ -882,10 +1060,14 @@ impl<'a> Parser<'a> {
             }
         }
         match declared {
-            Some((n, at)) if n != count => {
-                self.error(at, format!("numMaterials says {n} but the block holds {count} material(s)"))
-            }
-            None => self.warn(off, "Materials has no numMaterials; counting the materials instead"),
+            Some((n, at)) if n != count => self.error(
+                at,
+                format!("numMaterials says {n} but the block holds {count} material(s)"),
+            ),
+            None => self.warn(
+                off,
+                "Materials has no numMaterials; counting the materials instead",
+            ),
             _ => {}
         }
         self.scene_comments.materials = comments;
@@ -895,7 +1077,9 @@ impl<'a> Parser<'a> {
 
     fn parse_object_tree(&mut self, off: usize) {
         let before = self.comments_here();
-        let Some(open) = self.expect_open("Group") else { return };
+        let Some(open) = self.expect_open("Group") else {
+            return;
+        };
         if self.graph.is_some() {
             self.error(off, "a scene has one top-level Group; this is a second");
             self.skip_block();
@@ -904,8 +1088,13 @@ impl<'a> Parser<'a> {
         let mut graph = Graph::new();
         let root = graph.root();
         graph.node_mut(root).comments.before = before;
-        let mut stack =
-            vec![OpenBlock::Group { node: root, open, declared: None, count: 0, material: None }];
+        let mut stack = vec![OpenBlock::Group {
+            node: root,
+            open,
+            declared: None,
+            count: 0,
+            material: None,
+        }];
         while !stack.is_empty() {
             let Some(t) = self.next() else {
                 let (kind, open) = match stack.last() {
@@ -914,14 +1103,21 @@ impl<'a> Parser<'a> {
                     Some(OpenBlock::Csg { op, open, .. }) => (op.name(), *open),
                     None => break,
                 };
-                self.error(open, format!("unterminated {kind} block: expected \"}}\" before the end of the file"));
+                self.error(
+                    open,
+                    format!(
+                        "unterminated {kind} block: expected \"}}\" before the end of the file"
+                    ),
+                );
                 break;
             };
             match t.kind {
                 TokKind::Close => {
                     if let Some(frame) = stack.pop() {
                         let node = match &frame {
-                            OpenBlock::Group { node, .. } | OpenBlock::Transform { node, .. } | OpenBlock::Csg { node, .. } => *node,
+                            OpenBlock::Group { node, .. }
+                            | OpenBlock::Transform { node, .. }
+                            | OpenBlock::Csg { node, .. } => *node,
                         };
                         graph.node_mut(node).comments.end = self.comments_here();
                         self.close_frame(frame, &mut graph);
@@ -935,19 +1131,36 @@ impl<'a> Parser<'a> {
                     let w = self.text(t);
                     if let Some(frame) = stack.last_mut() {
                         match frame {
-                            OpenBlock::Group { node, declared, count, material, .. } => {
+                            OpenBlock::Group {
+                                node,
+                                declared,
+                                count,
+                                material,
+                                ..
+                            } => {
                                 let parent = *node;
                                 match w {
                                     "numObjects" => {
                                         let c = self.comments_here();
                                         if !c.is_empty() {
-                                            graph.node_mut(parent).comments.inner.entry(Anchor::Field("numObjects".into())).or_default().extend(c);
+                                            graph
+                                                .node_mut(parent)
+                                                .comments
+                                                .inner
+                                                .entry(Anchor::Field("numObjects".into()))
+                                                .or_default()
+                                                .extend(c);
                                         }
                                         if declared.is_some() {
-                                            self.error(t.start, "numObjects is given twice in this Group");
+                                            self.error(
+                                                t.start,
+                                                "numObjects is given twice in this Group",
+                                            );
                                         }
                                         let d = self.expect_count("numObjects");
-                                        if let Some(OpenBlock::Group { declared, .. }) = stack.last_mut() {
+                                        if let Some(OpenBlock::Group { declared, .. }) =
+                                            stack.last_mut()
+                                        {
                                             *declared = d.or(*declared);
                                         }
                                     }
@@ -962,10 +1175,14 @@ impl<'a> Parser<'a> {
                                     // The lecture's shorthand: a Material placed in a Group adds
                                     // it and applies it to what follows.
                                     "Material" => {
-                                        if let Some(m) = self.parse_material_block("Material", t.start) {
+                                        if let Some(m) =
+                                            self.parse_material_block("Material", t.start)
+                                        {
                                             self.materials.push(m);
                                             let idx = (self.materials.len() - 1) as u32;
-                                            if let Some(OpenBlock::Group { material, .. }) = stack.last_mut() {
+                                            if let Some(OpenBlock::Group { material, .. }) =
+                                                stack.last_mut()
+                                            {
                                                 *material = Some(idx);
                                             }
                                         }
@@ -973,7 +1190,9 @@ impl<'a> Parser<'a> {
                                     _ if OBJECT_KEYWORDS.contains(&w) => {
                                         *count += 1;
                                         let mat = *material;
-                                        if let Some(f) = self.start_object(w, t.start, parent, mat, &mut graph) {
+                                        if let Some(f) =
+                                            self.start_object(w, t.start, parent, mat, &mut graph)
+                                        {
                                             stack.push(f);
                                         }
                                     }
@@ -994,19 +1213,25 @@ impl<'a> Parser<'a> {
                                     }
                                 }
                             }
-                            OpenBlock::Transform { node, has_child, .. } => {
+                            OpenBlock::Transform {
+                                node, has_child, ..
+                            } => {
                                 let parent = *node;
                                 if OBJECT_KEYWORDS.contains(&w) {
                                     if *has_child {
                                         self.error(t.start, "a Transform holds exactly one object; this is a second (wrap them in a Group)");
                                     }
                                     *has_child = true;
-                                    if let Some(f) = self.start_object(w, t.start, parent, None, &mut graph) {
+                                    if let Some(f) =
+                                        self.start_object(w, t.start, parent, None, &mut graph)
+                                    {
                                         stack.push(f);
                                     }
                                 } else {
                                     let c = self.comments_here();
-                                    let Some(op) = self.parse_op(w, t.start) else { continue };
+                                    let Some(op) = self.parse_op(w, t.start) else {
+                                        continue;
+                                    };
                                     match stack.last_mut() {
                                         Some(OpenBlock::Transform { ops, has_child: false, .. }) => {
                                             if !c.is_empty() {
@@ -1018,21 +1243,31 @@ impl<'a> Parser<'a> {
                                     }
                                 }
                             }
-                            OpenBlock::Csg { node, op, count, material, .. } => {
+                            OpenBlock::Csg {
+                                node,
+                                op,
+                                count,
+                                material,
+                                ..
+                            } => {
                                 let (parent, op) = (*node, *op);
                                 if w == "MaterialIndex" {
                                     self.defer_comments();
                                     if let Some((i, at)) = self.expect_count("MaterialIndex") {
                                         let i = u32::try_from(i).unwrap_or(u32::MAX);
                                         self.material_refs.push((i, at));
-                                        if let Some(OpenBlock::Csg { material, .. }) = stack.last_mut() {
+                                        if let Some(OpenBlock::Csg { material, .. }) =
+                                            stack.last_mut()
+                                        {
                                             *material = Some(i);
                                         }
                                     }
                                 } else if OBJECT_KEYWORDS.contains(&w) {
                                     *count += 1;
                                     let mat = *material;
-                                    if let Some(f) = self.start_object(w, t.start, parent, mat, &mut graph) {
+                                    if let Some(f) =
+                                        self.start_object(w, t.start, parent, mat, &mut graph)
+                                    {
                                         stack.push(f);
                                     }
                                 } else {
@@ -1081,7 +1316,10 @@ impl<'a> Parser<'a> {
             other => {
                 if v.is_some() {
                     let (found, at) = self.describe(other);
-                    self.error(at, format!("expected \"}}\" to close {w} after {n} number(s), found {found}"));
+                    self.error(
+                        at,
+                        format!("expected \"}}\" to close {w} after {n} number(s), found {found}"),
+                    );
                 }
                 self.skip_block();
                 None
@@ -1118,7 +1356,12 @@ impl<'a> Parser<'a> {
                     other => {
                         if v.is_some() {
                             let (found, at) = self.describe(other);
-                            self.error(at, format!("expected \"}}\" to close {w} after {n} numbers, found {found}"));
+                            self.error(
+                                at,
+                                format!(
+                                    "expected \"}}\" to close {w} after {n} numbers, found {found}"
+                                ),
+                            );
                         }
                         // Resynchronise at the end of this block.
                         self.skip_block();
@@ -1127,7 +1370,10 @@ impl<'a> Parser<'a> {
                 }
                 let v = v?;
                 if w == "Rotate" {
-                    TransformOp::Rotate { axis: Vec3::new(v[0], v[1], v[2]), degrees: v[3] }
+                    TransformOp::Rotate {
+                        axis: Vec3::new(v[0], v[1], v[2]),
+                        degrees: v[3],
+                    }
                 } else {
                     let mut a = [0.0f32; 16];
                     a.copy_from_slice(&v);
@@ -1161,23 +1407,71 @@ impl<'a> Parser<'a> {
         let before = self.comments_here();
         let open = self.expect_open(w)?;
         let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind, comments: Comments| {
-            let id = graph.add(Node { kind, material, children: Vec::new(), comments });
+            let id = graph.add(Node {
+                kind,
+                material,
+                children: Vec::new(),
+                comments,
+            });
             graph.push_child(parent, id);
             this.record_offset(id, off);
             id
         };
         if let Some(op) = CsgOp::from_name(w) {
-            let node = attach(self, graph, NodeKind::Csg(op), Comments { before, ..Comments::default() });
-            return Some(OpenBlock::Csg { node, op, keyword: off, open, count: 0, material: None });
+            let node = attach(
+                self,
+                graph,
+                NodeKind::Csg(op),
+                Comments {
+                    before,
+                    ..Comments::default()
+                },
+            );
+            return Some(OpenBlock::Csg {
+                node,
+                op,
+                keyword: off,
+                open,
+                count: 0,
+                material: None,
+            });
         }
         match w {
             "Group" => {
-                let node = attach(self, graph, NodeKind::Group, Comments { before, ..Comments::default() });
-                Some(OpenBlock::Group { node, open, declared: None, count: 0, material: None })
+                let node = attach(
+                    self,
+                    graph,
+                    NodeKind::Group,
+                    Comments {
+                        before,
+                        ..Comments::default()
+                    },
+                );
+                Some(OpenBlock::Group {
+                    node,
+                    open,
+                    declared: None,
+                    count: 0,
+                    material: None,
+                })
             }
             "Transform" => {
-                let node = attach(self, graph, NodeKind::Transform(Vec::new()), Comments { before, ..Comments::default() });
-                Some(OpenBlock::Transform { node, keyword: off, open, ops: Vec::new(), has_child: false })
+                let node = attach(
+                    self,
+                    graph,
+                    NodeKind::Transform(Vec::new()),
+                    Comments {
+                        before,
+                        ..Comments::default()
+                    },
+                );
+                Some(OpenBlock::Transform {
+                    node,
+                    keyword: off,
+                    open,
+                    ops: Vec::new(),
+                    has_child: false,
+                })
             }
             _ => {
                 let (kind, mut comments) = self.parse_primitive(w, off, open)?;
@@ -1194,7 +1488,12 @@ impl<'a> Parser<'a> {
     }
 
     /// The primitive and the comments inside its block.
-    fn parse_primitive(&mut self, w: &str, off: usize, open: usize) -> Option<(NodeKind, Comments)> {
+    fn parse_primitive(
+        &mut self,
+        w: &str,
+        off: usize,
+        open: usize,
+    ) -> Option<(NodeKind, Comments)> {
         let (mut f, end) = self.read_fields(w, open)?;
         let comments = block_comments(Vec::new(), &mut f, end);
         let kind = match w {
@@ -1202,26 +1501,37 @@ impl<'a> Parser<'a> {
                 let center = self.take_vec3(&mut f, w, off, "center");
                 let radius = self.take_f32(&mut f, w, off, "radius");
                 self.reject_unused(&f, w, "center, radius");
-                NodeKind::Sphere { center: center?, radius: radius? }
+                NodeKind::Sphere {
+                    center: center?,
+                    radius: radius?,
+                }
             }
             "Plane" => {
                 let normal = self.take_vec3(&mut f, w, off, "normal");
                 let offset = self.take_f32(&mut f, w, off, "offset");
                 self.reject_unused(&f, w, "normal, offset");
-                NodeKind::Plane { normal: normal?, offset: offset? }
+                NodeKind::Plane {
+                    normal: normal?,
+                    offset: offset?,
+                }
             }
             "Triangle" => {
                 let a = self.take_vec3(&mut f, w, off, "vertex0");
                 let b = self.take_vec3(&mut f, w, off, "vertex1");
                 let c = self.take_vec3(&mut f, w, off, "vertex2");
                 self.reject_unused(&f, w, "vertex0, vertex1, vertex2");
-                NodeKind::Triangle { vertices: [a?, b?, c?] }
+                NodeKind::Triangle {
+                    vertices: [a?, b?, c?],
+                }
             }
             "Box" => {
                 let min = self.take_vec3(&mut f, w, off, "min");
                 let max = self.take_vec3(&mut f, w, off, "max");
                 self.reject_unused(&f, w, "min, max");
-                NodeKind::Box { min: min?, max: max? }
+                NodeKind::Box {
+                    min: min?,
+                    max: max?,
+                }
             }
             "TriangleMesh" => {
                 let Some(i) = f.iter().position(|x| x.name == "obj_file") else {
@@ -1232,7 +1542,10 @@ impl<'a> Parser<'a> {
                 self.reject_unused(&f, w, "obj_file");
                 let (name, name_off) = f[i].word.clone()?;
                 self.last_obj_name = name_off;
-                NodeKind::TriangleMesh { obj_file: name, mesh: MeshSlot::Unresolved }
+                NodeKind::TriangleMesh {
+                    obj_file: name,
+                    mesh: MeshSlot::Unresolved,
+                }
             }
             _ => return None,
         };
@@ -1245,7 +1558,13 @@ impl<'a> Parser<'a> {
 
     fn close_frame(&mut self, frame: OpenBlock, graph: &mut Graph) {
         match frame {
-            OpenBlock::Csg { node, op, keyword, count, .. } => {
+            OpenBlock::Csg {
+                node,
+                op,
+                keyword,
+                count,
+                ..
+            } => {
                 if count != 2 {
                     self.error(
                         keyword,
@@ -1257,11 +1576,24 @@ impl<'a> Parser<'a> {
                     self.check_operand(graph, c, op);
                 }
             }
-            OpenBlock::Group { declared: Some((n, at)), count, .. } if n != count => {
-                self.error(at, format!("numObjects says {n} but the Group holds {count} object(s)"));
+            OpenBlock::Group {
+                declared: Some((n, at)),
+                count,
+                ..
+            } if n != count => {
+                self.error(
+                    at,
+                    format!("numObjects says {n} but the Group holds {count} object(s)"),
+                );
             }
             OpenBlock::Group { .. } => {}
-            OpenBlock::Transform { node, keyword, ops, has_child, .. } => {
+            OpenBlock::Transform {
+                node,
+                keyword,
+                ops,
+                has_child,
+                ..
+            } => {
                 if !has_child {
                     self.error(keyword, "Transform needs one object after its operations");
                 }
@@ -1316,13 +1648,23 @@ impl<'a> Parser<'a> {
         let n = self.materials.len();
         for (i, at) in std::mem::take(&mut self.material_refs) {
             if i as usize >= n {
-                let range = if n == 0 { "the scene has no materials".to_string() } else { format!("valid indices are 0 to {}", n - 1) };
+                let range = if n == 0 {
+                    "the scene has no materials".to_string()
+                } else {
+                    format!("valid indices are 0 to {}", n - 1)
+                };
                 let written = self.word_at(at);
-                self.error(at, format!("MaterialIndex {written} is out of range: {range}"));
+                self.error(
+                    at,
+                    format!("MaterialIndex {written} is out of range: {range}"),
+                );
             }
         }
         if self.camera.is_none() && !self.camera_seen {
-            self.error(end, "the scene has no camera (OrthographicCamera or PerspectiveCamera)");
+            self.error(
+                end,
+                "the scene has no camera (OrthographicCamera or PerspectiveCamera)",
+            );
         }
         if self.graph.is_none() && !self.group_seen {
             self.error(end, "the scene has no Group of objects");
@@ -1330,7 +1672,10 @@ impl<'a> Parser<'a> {
         if let Some(graph) = &self.graph {
             // Composed through each chain, so nested scales are judged together.
             for p in validate::check_world_chain(graph) {
-                let at = p.node().and_then(|id| self.node_offsets.get(id.index()).copied()).unwrap_or(0);
+                let at = p
+                    .node()
+                    .and_then(|id| self.node_offsets.get(id.index()).copied())
+                    .unwrap_or(0);
                 self.error(at, p.message);
             }
         }
@@ -1344,10 +1689,16 @@ impl<'a> Parser<'a> {
                 .collect();
             for (k, at) in missing.iter().enumerate() {
                 if k == 5 {
-                    self.warn(*at, format!("{} more objects have no material", missing.len() - 5));
+                    self.warn(
+                        *at,
+                        format!("{} more objects have no material", missing.len() - 5),
+                    );
                     break;
                 }
-                self.warn(*at, "no MaterialIndex applies to this object; it uses the default grey material");
+                self.warn(
+                    *at,
+                    "no MaterialIndex applies to this object; it uses the default grey material",
+                );
             }
         }
         let unshown = self.summarise_unshown();
@@ -1364,7 +1715,13 @@ impl<'a> Parser<'a> {
             })
         };
         let meshes = self.mesh_refs(scene.as_ref());
-        ParseOutcome { scene, diagnostics: Diagnostics(self.diags), lost_comments: self.lost_comments, meshes, unshown }
+        ParseOutcome {
+            scene,
+            diagnostics: Diagnostics(self.diags),
+            lost_comments: self.lost_comments,
+            meshes,
+            unshown,
+        }
     }
 
     /// The TriangleMesh nodes with their file names and locations (also for a scene too
@@ -1373,7 +1730,11 @@ impl<'a> Parser<'a> {
         let graph = scene.map(|s| &s.graph).or(self.graph.as_ref());
         let place = |off: usize| {
             let d = self.src.diagnostic(Severity::Error, off, "");
-            Located { file: d.file, line: d.line, col: d.col }
+            Located {
+                file: d.file,
+                line: d.line,
+                col: d.col,
+            }
         };
         let mut refs: Vec<MeshRef> = self
             .mesh_name_offsets
@@ -1383,10 +1744,16 @@ impl<'a> Parser<'a> {
                     Some(NodeKind::TriangleMesh { obj_file, .. }) => obj_file.clone(),
                     _ => return None,
                 };
-                Some(MeshRef { node, obj_file, at: place(off), operand_of: Vec::new() })
+                Some(MeshRef {
+                    node,
+                    obj_file,
+                    at: place(off),
+                    operand_of: Vec::new(),
+                })
             })
             .collect();
-        let index: HashMap<NodeId, usize> = refs.iter().enumerate().map(|(i, r)| (r.node, i)).collect();
+        let index: HashMap<NodeId, usize> =
+            refs.iter().enumerate().map(|(i, r)| (r.node, i)).collect();
         for &(node, op, off) in &self.mesh_operands {
             if let Some(&i) = index.get(&node) {
                 refs[i].operand_of.push((op, place(off)));

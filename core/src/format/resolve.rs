@@ -35,11 +35,19 @@ pub fn resolve_meshes(out: &mut ParseOutcome, base_dir: Option<&Path>, cache: &m
         let slot = match resolve_obj_path(name, base_dir).and_then(|path| cache.load(&path)) {
             Ok(mesh) => {
                 if let Some(dir) = base_dir.filter(|d| !d.join(name).is_file()) {
-                    let dir = if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() };
+                    let dir = if dir.as_os_str().is_empty() {
+                        ".".to_string()
+                    } else {
+                        dir.display().to_string()
+                    };
                     report.push(Severity::Warning, &r.at, format!("OBJ file \"{name}\" is not in the scene's folder ({dir}); using the one in the current folder"));
                 }
                 if mesh.triangle_count() == 0 {
-                    report.push(Severity::Warning, &r.at, format!("OBJ file \"{name}\" has no triangles"));
+                    report.push(
+                        Severity::Warning,
+                        &r.at,
+                        format!("OBJ file \"{name}\" has no triangles"),
+                    );
                 }
                 for (op, at) in &r.operand_of {
                     let key = Arc::as_ptr(&mesh) as usize;
@@ -55,12 +63,19 @@ pub fn resolve_meshes(out: &mut ParseOutcome, base_dir: Option<&Path>, cache: &m
                 MeshSlot::Loaded(mesh)
             }
             Err(msg) => {
-                report.push(Severity::Error, &r.at, format!("cannot load OBJ file \"{name}\": {msg}"));
+                report.push(
+                    Severity::Error,
+                    &r.at,
+                    format!("cannot load OBJ file \"{name}\": {msg}"),
+                );
                 MeshSlot::Failed(msg.to_string())
             }
         };
-        if let Some(NodeKind::TriangleMesh { mesh, .. }) =
-            out.scene.as_mut().and_then(|s| s.graph.get_mut(r.node)).map(|n| &mut n.kind)
+        if let Some(NodeKind::TriangleMesh { mesh, .. }) = out
+            .scene
+            .as_mut()
+            .and_then(|s| s.graph.get_mut(r.node))
+            .map(|n| &mut n.kind)
         {
             *mesh = slot;
         }
@@ -96,11 +111,18 @@ impl Capped {
 
     fn finish(mut self) -> (Vec<Diagnostic>, UnshownSummary) {
         let mut summary = UnshownSummary::default();
-        for (k, (severity, what)) in [(Severity::Error, "error"), (Severity::Warning, "warning")].into_iter().enumerate() {
+        for (k, (severity, what)) in [(Severity::Error, "error"), (Severity::Warning, "warning")]
+            .into_iter()
+            .enumerate()
+        {
             let n = self.unshown[k];
             if let Some(at) = self.first_unshown[k].clone().filter(|_| n > 0) {
                 let s = if n == 1 { "" } else { "s" };
-                self.new.push(diagnostic(severity, &at, &format!("… and {n} more {what}{s}")));
+                self.new.push(diagnostic(
+                    severity,
+                    &at,
+                    &format!("… and {n} more {what}{s}"),
+                ));
                 summary.summaries += 1;
                 match severity {
                     Severity::Error => summary.errors = (n, Some(at)),
@@ -114,5 +136,11 @@ impl Capped {
 
 fn diagnostic(severity: Severity, at: &Located, message: &str) -> Diagnostic {
     let message = escape_controls(message).into_owned();
-    Diagnostic { severity, file: at.file.clone(), line: at.line, col: at.col, message }
+    Diagnostic {
+        severity,
+        file: at.file.clone(),
+        line: at.line,
+        col: at.col,
+        message,
+    }
 }

@@ -29,7 +29,10 @@ struct State {
 
 impl<'a> TokenStream<'a> {
     pub fn new(text: &'a str) -> Self {
-        TokenStream { text, state: RefCell::new(State::default()) }
+        TokenStream {
+            text,
+            state: RefCell::new(State::default()),
+        }
     }
 
     /// Token number `i` of the file. Indices must not go back before the current chunk: the
@@ -39,8 +42,13 @@ impl<'a> TokenStream<'a> {
         while i >= s.first + s.tokens.len() && s.next_chunk < self.text.len() {
             self.read_chunk(&mut s);
         }
-        debug_assert!(i >= s.first || s.tokens.is_empty(), "token {i} is behind the stream");
-        i.checked_sub(s.first).and_then(|k| s.tokens.get(k)).copied()
+        debug_assert!(
+            i >= s.first || s.tokens.is_empty(),
+            "token {i} is behind the stream"
+        );
+        i.checked_sub(s.first)
+            .and_then(|k| s.tokens.get(k))
+            .copied()
     }
 
     /// Comment number `k` of the file, once the chunk holding the token after it was read
@@ -62,7 +70,8 @@ impl<'a> TokenStream<'a> {
         let start = s.next_chunk;
         let end = chunk_end(self.text, start);
         // Chunks end after ASCII bytes, so both ends are char boundaries.
-        let (mut tokens, comments) = tokenize_with_comments(self.text.get(start..end).unwrap_or(""));
+        let (mut tokens, comments) =
+            tokenize_with_comments(self.text.get(start..end).unwrap_or(""));
         for t in &mut tokens {
             t.start += start;
             t.end += start;
@@ -87,7 +96,10 @@ fn chunk_end(text: &str, start: usize) -> usize {
     if target >= bytes.len() {
         return bytes.len();
     }
-    let line_start = bytes[start..target].iter().rposition(|&b| b == b'\n').map_or(start, |i| start + i + 1);
+    let line_start = bytes[start..target]
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(start, |i| start + i + 1);
     let mut comment = bytes[line_start..target].contains(&b'#');
     for (i, &b) in bytes.iter().enumerate().skip(target) {
         match b {

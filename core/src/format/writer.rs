@@ -9,7 +9,8 @@ use std::fmt::Write as _;
 use glam::Vec3;
 
 use crate::scene::{
-    Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Problem, Scene, TransformOp, check_scene,
+    Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Problem, Scene,
+    TransformOp, check_scene,
 };
 
 const IND: &str = "    ";
@@ -79,7 +80,11 @@ impl<'a> Inner<'a> {
 /// otherwise what must be fixed first, and nothing is written.
 pub fn try_write_scene(scene: &Scene) -> Result<String, Vec<Problem>> {
     let problems = check_scene(scene);
-    if problems.is_empty() { Ok(write_scene(scene)) } else { Err(problems) }
+    if problems.is_empty() {
+        Ok(write_scene(scene))
+    } else {
+        Err(problems)
+    }
 }
 
 /// The scene's text, unchecked: a scene that breaks a rule gives text the parser rejects.
@@ -111,7 +116,11 @@ pub fn write_scene(scene: &Scene) -> String {
     } else if !sc.lights.is_empty() {
         // No Lights block to hold them (writing one would light the scene): keep them here.
         out.push('\n');
-        comment_lines(&mut out, "", &sc.lights.lines().cloned().collect::<Vec<_>>());
+        comment_lines(
+            &mut out,
+            "",
+            &sc.lights.lines().cloned().collect::<Vec<_>>(),
+        );
     }
     let bg = &scene.background;
     if bg.color.is_some() || bg.ambient.is_some() || !sc.background.is_empty() {
@@ -170,7 +179,11 @@ fn write_camera(out: &mut String, cam: &Camera, comments: &Comments) {
     comment_lines(out, "", &comments.before);
     let _ = writeln!(out, "{kw} {{");
     let mut inner = Inner::new(comments);
-    for (name, v) in [("center", cam.center()), ("direction", cam.direction()), ("up", cam.up())] {
+    for (name, v) in [
+        ("center", cam.center()),
+        ("direction", cam.direction()),
+        ("up", cam.up()),
+    ] {
         inner.field(out, IND, name);
         let _ = writeln!(out, "{IND}{name} {}", v3(v));
     }
@@ -195,7 +208,14 @@ fn write_op(out: &mut String, ind: &str, op: &TransformOp) {
             let _ = writeln!(out, "{ind}Matrix {{");
             for r in 0..4 {
                 let row = m.row(r);
-                let _ = writeln!(out, "{ind}{IND}{} {} {} {}", num(row.x), num(row.y), num(row.z), num(row.w));
+                let _ = writeln!(
+                    out,
+                    "{ind}{IND}{} {} {} {}",
+                    num(row.x),
+                    num(row.y),
+                    num(row.z),
+                    num(row.w)
+                );
             }
             writeln!(out, "{ind}}}")
         }
@@ -205,20 +225,35 @@ fn write_op(out: &mut String, ind: &str, op: &TransformOp) {
 enum Work {
     /// `before_written`: the node's leading comments are already out (in a Group they go
     /// above the MaterialIndex written for the node, where the parser takes them back).
-    Open { id: NodeId, depth: usize, in_group: bool, before_written: bool },
+    Open {
+        id: NodeId,
+        depth: usize,
+        in_group: bool,
+        before_written: bool,
+    },
     Text(String),
 }
 
 /// Depth-first with an explicit stack, so deep trees cannot overflow the call stack.
 fn write_graph(out: &mut String, graph: &Graph) {
-    let mut stack = vec![Work::Open { id: graph.root(), depth: 0, in_group: false, before_written: false }];
+    let mut stack = vec![Work::Open {
+        id: graph.root(),
+        depth: 0,
+        in_group: false,
+        before_written: false,
+    }];
     while let Some(w) = stack.pop() {
         let (id, depth, in_group, before_written) = match w {
             Work::Text(t) => {
                 out.push_str(&t);
                 continue;
             }
-            Work::Open { id, depth, in_group, before_written } => (id, depth, in_group, before_written),
+            Work::Open {
+                id,
+                depth,
+                in_group,
+                before_written,
+            } => (id, depth, in_group, before_written),
         };
         let Some(node) = graph.get(id) else { continue };
         let mut depth = depth;
@@ -230,7 +265,10 @@ fn write_graph(out: &mut String, graph: &Graph) {
             && let Some(m) = node.material
         {
             let ind = indent(depth);
-            let _ = writeln!(out, "{ind}Group {{\n{ind}{IND}numObjects 1\n{ind}{IND}MaterialIndex {m}");
+            let _ = writeln!(
+                out,
+                "{ind}Group {{\n{ind}{IND}numObjects 1\n{ind}{IND}MaterialIndex {m}"
+            );
             closers.push(format!("{ind}}}\n"));
             depth += 1;
         }
@@ -261,7 +299,9 @@ fn write_graph(out: &mut String, graph: &Graph) {
                 let mut work = Vec::new();
                 for &c in &node.children {
                     let child = graph.get(c);
-                    if let Some(before) = child.map(|n| &n.comments.before).filter(|b| !b.is_empty()) {
+                    if let Some(before) =
+                        child.map(|n| &n.comments.before).filter(|b| !b.is_empty())
+                    {
                         let mut t = String::new();
                         comment_lines(&mut t, &inner, before);
                         work.push(Work::Text(t));
@@ -273,7 +313,12 @@ fn write_graph(out: &mut String, graph: &Graph) {
                         work.push(Work::Text(format!("{inner}MaterialIndex {m}\n")));
                         current = Some(m);
                     }
-                    work.push(Work::Open { id: c, depth: depth + 1, in_group: true, before_written: true });
+                    work.push(Work::Open {
+                        id: c,
+                        depth: depth + 1,
+                        in_group: true,
+                        before_written: true,
+                    });
                 }
                 closers.insert(0, own_closer(ic));
                 for c in closers.into_iter().rev() {
@@ -292,7 +337,12 @@ fn write_graph(out: &mut String, graph: &Graph) {
                     stack.push(Work::Text(c));
                 }
                 for &c in node.children.iter().rev() {
-                    stack.push(Work::Open { id: c, depth: depth + 1, in_group: false, before_written: false });
+                    stack.push(Work::Open {
+                        id: c,
+                        depth: depth + 1,
+                        in_group: false,
+                        before_written: false,
+                    });
                 }
                 continue;
             }
@@ -342,7 +392,11 @@ mod tests {
     #[test]
     fn numbers_are_written_so_they_read_back_bit_for_bit() {
         for x in [-0.0f32, 0.0, 1e-45, -3.4028235e38, 0.1, 1.0 / 3.0] {
-            assert_eq!(num(x).parse::<f32>().map(f32::to_bits), Ok(x.to_bits()), "{x}");
+            assert_eq!(
+                num(x).parse::<f32>().map(f32::to_bits),
+                Ok(x.to_bits()),
+                "{x}"
+            );
         }
     }
 
@@ -352,13 +406,19 @@ mod tests {
         let text = "PerspectiveCamera { center -0 0 0 direction 0 0 -1 up 0 1 0 angle 90 }\n\
                     Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n\
                     Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 5 } }\n";
-        let read = |t: &str| parse_scene(t.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result();
+        let read =
+            |t: &str| parse_scene(t.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result();
         let scene = read(text).expect("parses").0;
         let back = read(&write_scene(&scene)).expect("reparses").0;
         assert_eq!(back.camera.center().x.to_bits(), (-0.0f32).to_bits());
         let render = |s| render_frame(&compile(s), &RenderSettings::new(4, 4));
         let (a, b) = (render(&scene), render(&back));
-        assert!(a.samples.iter().zip(&b.samples).all(|(x, y)| x.color == y.color && x.t.to_bits() == y.t.to_bits()));
+        assert!(
+            a.samples
+                .iter()
+                .zip(&b.samples)
+                .all(|(x, y)| x.color == y.color && x.t.to_bits() == y.t.to_bits())
+        );
     }
 
     const TWO: &str = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
@@ -367,7 +427,10 @@ mod tests {
                        Group { numObjects 2 MaterialIndex 1 Sphere { center -1 0 0 radius 1 } Sphere { center 1 0 0 radius 1 } }\n";
 
     fn two() -> Scene {
-        parse_scene(TWO.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0
+        parse_scene(TWO.as_bytes(), "t.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("parses")
+            .0
     }
 
     #[test]
@@ -380,18 +443,29 @@ mod tests {
         }
         let p = try_write_scene(&bad).expect_err("a zero light direction");
         assert_eq!(p.len(), 1);
-        assert_eq!((p[0].place, p[0].field.as_str()), (crate::scene::Place::Light(0), "direction"));
-        assert_eq!(p[0].message, "light 0: DirectionalLight: direction must not be zero");
+        assert_eq!(
+            (p[0].place, p[0].field.as_str()),
+            (crate::scene::Place::Light(0), "direction")
+        );
+        assert_eq!(
+            p[0].message,
+            "light 0: DirectionalLight: direction must not be zero"
+        );
         // An incomplete node (a mesh with no file yet) is never written either.
         let mut incomplete = scene;
         let root = incomplete.graph.root();
-        let mesh = incomplete.graph.add(crate::scene::Node::new(NodeKind::TriangleMesh {
-            obj_file: String::new(),
-            mesh: crate::scene::MeshSlot::Failed(String::new()),
-        }));
+        let mesh = incomplete
+            .graph
+            .add(crate::scene::Node::new(NodeKind::TriangleMesh {
+                obj_file: String::new(),
+                mesh: crate::scene::MeshSlot::Failed(String::new()),
+            }));
         incomplete.graph.push_child(root, mesh);
         let p = try_write_scene(&incomplete).expect_err("no OBJ file");
-        assert!(p.len() == 1 && p[0].incomplete && p[0].node() == Some(mesh), "{p:?}");
+        assert!(
+            p.len() == 1 && p[0].incomplete && p[0].node() == Some(mesh),
+            "{p:?}"
+        );
     }
 
     #[test]
@@ -404,10 +478,19 @@ mod tests {
         scene.graph.node_mut(second).material = None;
         assert_eq!(scene.graph.effective_materials()[second.index()], Some(1));
         let text = write_scene(&scene);
-        let back = parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("reparses").0;
+        let back = parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("reparses")
+            .0;
         assert_eq!(back.graph, scene.graph.with_listed_materials());
         let render = |s| render_frame(&compile(s), &RenderSettings::new(8, 8));
         let (a, b) = (render(&scene), render(&back));
-        assert!(a.samples.iter().zip(&b.samples).all(|(x, y)| x.color == y.color), "same colours before and after");
+        assert!(
+            a.samples
+                .iter()
+                .zip(&b.samples)
+                .all(|(x, y)| x.color == y.color),
+            "same colours before and after"
+        );
     }
 }

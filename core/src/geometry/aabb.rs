@@ -14,7 +14,10 @@ impl Default for Aabb {
 }
 
 impl Aabb {
-    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
 
     pub fn new(min: Vec3, max: Vec3) -> Self {
         Aabb { min, max }
@@ -25,11 +28,17 @@ impl Aabb {
     }
 
     pub fn grow(self, p: Vec3) -> Self {
-        Aabb { min: self.min.min(p), max: self.max.max(p) }
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
     }
 
     pub fn union(self, o: Aabb) -> Self {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
     }
 
     pub fn is_empty(&self) -> bool {

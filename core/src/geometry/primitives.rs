@@ -26,7 +26,11 @@ pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> 
     let sq = disc.sqrt();
     // Numerically stable pair of roots.
     let q = -half_b - sq.copysign(half_b);
-    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    let (t0, t1) = if q != 0.0 {
+        (q / a, c / q)
+    } else {
+        (-half_b / a, -half_b / a)
+    };
     Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
 }
 
@@ -42,14 +46,24 @@ fn sphere_roots_f64(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> 
         return None;
     }
     let q = -half_b - disc.sqrt().copysign(half_b);
-    let (t0, t1) = if q != 0.0 { (q / a, c / q) } else { (-half_b / a, -half_b / a) };
+    let (t0, t1) = if q != 0.0 {
+        (q / a, c / q)
+    } else {
+        (-half_b / a, -half_b / a)
+    };
     let (t0, t1) = if t0 > t1 { (t1, t0) } else { (t0, t1) };
     Some((t0 as f32, t1 as f32))
 }
 
 /// Smallest root of |o + t d − c|² = r² in (t_min, t_max).
 #[inline]
-pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max: f32) -> Option<f32> {
+pub fn intersect_sphere(
+    ray: &Ray,
+    center: Vec3,
+    radius: f32,
+    t_min: f32,
+    t_max: f32,
+) -> Option<f32> {
     let (t0, t1) = sphere_roots(ray, center, radius)?;
     if t0 > t_min && t0 < t_max {
         Some(t0)
@@ -62,7 +76,13 @@ pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_min: f32, t_max:
 
 /// The plane {p : n·p = offset}. A ray parallel to it never hits.
 #[inline]
-pub fn intersect_plane(ray: &Ray, normal: Vec3, offset: f32, t_min: f32, t_max: f32) -> Option<f32> {
+pub fn intersect_plane(
+    ray: &Ray,
+    normal: Vec3,
+    offset: f32,
+    t_min: f32,
+    t_max: f32,
+) -> Option<f32> {
     let denom = normal.dot(ray.direction);
     if denom == 0.0 {
         return None;
@@ -150,7 +170,11 @@ pub fn box_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<(f32, u32, f32, u32)>
         let (t_lo, t_hi) = ((min[axis] - o[axis]) * inv, (max[axis] - o[axis]) * inv);
         let a = axis as u32 * 2;
         // Moving toward +axis the ray enters through the min face and leaves through the max.
-        let (t_in, f_in, t_out, f_out) = if d[axis] > 0.0 { (t_lo, a, t_hi, a + 1) } else { (t_hi, a + 1, t_lo, a) };
+        let (t_in, f_in, t_out, f_out) = if d[axis] > 0.0 {
+            (t_lo, a, t_hi, a + 1)
+        } else {
+            (t_hi, a + 1, t_lo, a)
+        };
         if t_in > near {
             near = t_in;
             near_face = f_in;
@@ -165,7 +189,10 @@ pub fn box_span(ray: &Ray, min: Vec3, max: Vec3) -> Option<(f32, u32, f32, u32)>
 
 /// The box around a sphere (a negative radius is a sphere of its absolute size).
 pub fn sphere_bounds(center: Vec3, radius: f32) -> super::Aabb {
-    super::Aabb::new(center - Vec3::splat(radius.abs()), center + Vec3::splat(radius.abs()))
+    super::Aabb::new(
+        center - Vec3::splat(radius.abs()),
+        center + Vec3::splat(radius.abs()),
+    )
 }
 
 /// A sphere's outward normal at `p` (Z where `p` is its centre).
@@ -188,31 +215,52 @@ mod tests {
     #[test]
     fn sphere_hit_from_inside_gives_far_root() {
         let r = Ray::new(Vec3::ZERO, Vec3::X);
-        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 2.0, 0.0, f32::INFINITY), Some(2.0));
+        assert_eq!(
+            intersect_sphere(&r, Vec3::ZERO, 2.0, 0.0, f32::INFINITY),
+            Some(2.0)
+        );
     }
 
     #[test]
     fn sphere_with_unnormalised_direction_keeps_parameter_meaning() {
         let r = Ray::new(Vec3::new(0.0, 0.0, 10.0), Vec3::new(0.0, 0.0, -2.0));
-        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), Some(4.5));
+        assert_eq!(
+            intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY),
+            Some(4.5)
+        );
     }
 
     #[test]
     fn sphere_miss_and_negative_tmin_behaviour() {
         let r = Ray::new(Vec3::new(0.0, 5.0, 10.0), Vec3::NEG_Z);
-        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), None);
+        assert_eq!(
+            intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY),
+            None
+        );
         // Sphere behind the origin is found only with t_min = -inf (orthographic cameras).
         let r = Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::NEG_Z);
-        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY), None);
-        assert_eq!(intersect_sphere(&r, Vec3::ZERO, 1.0, f32::NEG_INFINITY, f32::INFINITY), Some(-11.0));
+        assert_eq!(
+            intersect_sphere(&r, Vec3::ZERO, 1.0, 0.0, f32::INFINITY),
+            None
+        );
+        assert_eq!(
+            intersect_sphere(&r, Vec3::ZERO, 1.0, f32::NEG_INFINITY, f32::INFINITY),
+            Some(-11.0)
+        );
     }
 
     #[test]
     fn plane_hit_matches_offset() {
         let r = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y);
-        assert_eq!(intersect_plane(&r, Vec3::Y, -2.0, 0.0, f32::INFINITY), Some(7.0));
+        assert_eq!(
+            intersect_plane(&r, Vec3::Y, -2.0, 0.0, f32::INFINITY),
+            Some(7.0)
+        );
         let parallel = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::X);
-        assert_eq!(intersect_plane(&parallel, Vec3::Y, -2.0, 0.0, f32::INFINITY), None);
+        assert_eq!(
+            intersect_plane(&parallel, Vec3::Y, -2.0, 0.0, f32::INFINITY),
+            None
+        );
     }
 
     #[test]
@@ -232,7 +280,10 @@ mod tests {
     #[test]
     fn degenerate_triangle_never_hits() {
         let r = Ray::new(Vec3::new(0.5, 0.0, 3.0), Vec3::NEG_Z);
-        assert!(intersect_triangle(&r, Vec3::ZERO, Vec3::X, Vec3::X * 2.0, 0.0, f32::INFINITY).is_none());
+        assert!(
+            intersect_triangle(&r, Vec3::ZERO, Vec3::X, Vec3::X * 2.0, 0.0, f32::INFINITY)
+                .is_none()
+        );
     }
 
     #[test]
@@ -240,7 +291,10 @@ mod tests {
         let r = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
         let (t0, f0, t1, f1) = box_span(&r, Vec3::splat(-1.0), Vec3::splat(1.0)).expect("hit");
         assert_eq!((t0, t1), (4.0, 6.0));
-        assert_eq!((box_face_normal(f0), box_face_normal(f1)), (Vec3::NEG_X, Vec3::X));
+        assert_eq!(
+            (box_face_normal(f0), box_face_normal(f1)),
+            (Vec3::NEG_X, Vec3::X)
+        );
         let miss = Ray::new(Vec3::new(-5.0, 2.0, 0.0), Vec3::X);
         assert!(box_span(&miss, Vec3::splat(-1.0), Vec3::splat(1.0)).is_none());
     }

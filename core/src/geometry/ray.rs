@@ -20,6 +20,9 @@ impl Ray {
     /// The same ray expressed in another space: origin as a point, direction as a vector,
     /// direction deliberately not renormalised.
     pub fn transformed(&self, m: &Mat4) -> Ray {
-        Ray { origin: m.transform_point3(self.origin), direction: m.transform_vector3(self.direction) }
+        Ray {
+            origin: m.transform_point3(self.origin),
+            direction: m.transform_vector3(self.direction),
+        }
     }
 }

@@ -22,11 +22,18 @@ impl Transform {
     /// From a matrix composed in f64: inverted there, so tiny and huge scales keep their
     /// digits in the f32 pair.
     pub fn from_f64(world_from_object: DMat4) -> Transform {
-        Self::from_pair(world_from_object.as_mat4(), world_from_object.inverse().as_mat4())
+        Self::from_pair(
+            world_from_object.as_mat4(),
+            world_from_object.inverse().as_mat4(),
+        )
     }
 
     fn from_pair(world_from_object: Mat4, inv: Mat4) -> Transform {
-        Transform { world_from_object, object_from_world: inv, normal_from_object: Mat3::from_mat4(inv).transpose() }
+        Transform {
+            world_from_object,
+            object_from_world: inv,
+            normal_from_object: Mat3::from_mat4(inv).transpose(),
+        }
     }
 
     /// An object-space normal in world space by (M⁻¹)ᵀ, normalised: perpendicular to the
@@ -44,6 +51,10 @@ impl Transform {
 
     /// The world box around an object-space box; an unbounded one (a plane) stays as it is.
     pub fn world_bounds(&self, local: Aabb) -> Aabb {
-        if local.is_finite() { local.transformed(&self.world_from_object) } else { local }
+        if local.is_finite() {
+            local.transformed(&self.world_from_object)
+        } else {
+            local
+        }
     }
 }

@@ -23,21 +23,48 @@ pub struct CameraRays {
 impl CameraRays {
     pub fn new(camera: &Camera) -> Self {
         let (center, dir, up, extent, perspective) = match *camera {
-            Camera::Orthographic { center, direction, up, size } => (center, direction, up, size, false),
-            Camera::Perspective { center, direction, up, angle } => {
-                (center, direction, up, 2.0 * (angle.to_radians() * 0.5).tan(), true)
-            }
+            Camera::Orthographic {
+                center,
+                direction,
+                up,
+                size,
+            } => (center, direction, up, size, false),
+            Camera::Perspective {
+                center,
+                direction,
+                up,
+                angle,
+            } => (
+                center,
+                direction,
+                up,
+                2.0 * (angle.to_radians() * 0.5).tan(),
+                true,
+            ),
         };
         // Overflow-safe: a direction of 0 0 -3e38 is just -z.
         let direction = unit(dir).unwrap_or(Vec3::NEG_Z);
-        let horizontal = direction.cross(unit(up).unwrap_or(Vec3::Y)).normalize_or(Vec3::X);
+        let horizontal = direction
+            .cross(unit(up).unwrap_or(Vec3::Y))
+            .normalize_or(Vec3::X);
         let up = horizontal.cross(direction);
-        CameraRays { center, direction, horizontal, up, extent, perspective }
+        CameraRays {
+            center,
+            direction,
+            horizontal,
+            up,
+            extent,
+            perspective,
+        }
     }
 
     /// Orthographic rays must find hits behind the camera centre (scene1_07 relies on it).
     pub fn t_min(&self) -> f32 {
-        if self.perspective { 0.0 } else { f32::NEG_INFINITY }
+        if self.perspective {
+            0.0
+        } else {
+            f32::NEG_INFINITY
+        }
     }
 
     /// The ray through screen point (x, y) in [0, 1]², y up.
@@ -47,7 +74,10 @@ impl CameraRays {
             let d = self.direction + sx * self.horizontal + sy * self.up;
             Ray::new(self.center, d.normalize())
         } else {
-            Ray::new(self.center + sx * self.horizontal + sy * self.up, self.direction)
+            Ray::new(
+                self.center + sx * self.horizontal + sy * self.up,
+                self.direction,
+            )
         }
     }
 
@@ -66,7 +96,11 @@ impl CameraRays {
                 let (x, _) = screen_point(i, 0, width, height);
                 let sx = (x - 0.5) * self.extent;
                 // The first addition of `ray_at`, in its order, so the sum stays bit-identical.
-                if self.perspective { self.direction + sx * self.horizontal } else { self.center + sx * self.horizontal }
+                if self.perspective {
+                    self.direction + sx * self.horizontal
+                } else {
+                    self.center + sx * self.horizontal
+                }
             })
             .collect();
         let rows = (0..height)
@@ -75,7 +109,11 @@ impl CameraRays {
                 ((y - 0.5) * self.extent) * self.up
             })
             .collect();
-        PixelRays { camera: *self, columns, rows }
+        PixelRays {
+            camera: *self,
+            columns,
+            rows,
+        }
     }
 }
 
@@ -102,8 +140,17 @@ impl PixelRays {
     /// The rays of row `row` (counted from the top).
     #[inline]
     pub fn row(&self, row: u32) -> RowRays<'_> {
-        let sy_up = self.rows.get(row as usize).or(self.rows.last()).copied().unwrap_or(Vec3::ZERO);
-        RowRays { camera: &self.camera, columns: &self.columns, sy_up }
+        let sy_up = self
+            .rows
+            .get(row as usize)
+            .or(self.rows.last())
+            .copied()
+            .unwrap_or(Vec3::ZERO);
+        RowRays {
+            camera: &self.camera,
+            columns: &self.columns,
+            sy_up,
+        }
     }
 }
 
@@ -196,8 +243,16 @@ mod tests {
                     r.fill(&mut filled);
                     assert_eq!(filled.len(), w as usize);
                     for i in 0..w {
-                        assert_eq!(r.ray(i), c.pixel_ray(i, row, w, h), "{w}x{h} pixel ({i}, {row})");
-                        assert_eq!(filled[i as usize], r.ray(i), "fill, {w}x{h} pixel ({i}, {row})");
+                        assert_eq!(
+                            r.ray(i),
+                            c.pixel_ray(i, row, w, h),
+                            "{w}x{h} pixel ({i}, {row})"
+                        );
+                        assert_eq!(
+                            filled[i as usize],
+                            r.ray(i),
+                            "fill, {w}x{h} pixel ({i}, {row})"
+                        );
                     }
                 }
             }

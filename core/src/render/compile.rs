@@ -7,26 +7,38 @@ use std::sync::Arc;
 
 use glam::{DMat4, Vec3, Vec3A};
 
+use super::NormalTransform;
 use super::camera::CameraRays;
 use super::csg::CsgTree;
-use super::NormalTransform;
 use crate::accel::Bvh;
 use crate::geometry::{
-    Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere, intersect_triangle,
-    sphere_bounds, sphere_normal, triangle_normal,
+    Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere,
+    intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
 };
 use crate::scene::validate::compose_f64;
 use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
 
 #[derive(Clone, Debug)]
 pub enum Shape {
-    Sphere { center: Vec3, radius: f32 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
     /// `normal` is unit length: the plane is {p : normal·p = offset}.
-    Plane { normal: Vec3, offset: f32 },
-    Triangle { vertices: [Vec3; 3], normal: Vec3 },
+    Plane {
+        normal: Vec3,
+        offset: f32,
+    },
+    Triangle {
+        vertices: [Vec3; 3],
+        normal: Vec3,
+    },
     Mesh(Arc<Mesh>),
     /// An axis-aligned box in object space; a hit's `prim` is the face (axis·2, +1 for max).
-    Box { min: Vec3, max: Vec3 },
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
     /// A CSG subtree whose leaves carry their own world transforms and materials; a hit's
     /// `prim` is the boundary code of `csg::CsgTree` (leaf, exit and flip bits).
     Csg(Arc<CsgTree>),
@@ -97,30 +109,59 @@ impl CompiledScene {
                     }
                     continue;
                 }
-                NodeKind::Sphere { center, radius } => Shape::Sphere { center: *center, radius: *radius },
+                NodeKind::Sphere { center, radius } => Shape::Sphere {
+                    center: *center,
+                    radius: *radius,
+                },
                 NodeKind::Plane { normal, offset } => {
                     // The offset is measured along the normalised normal, as the course's
                     // Plane does.
-                    Shape::Plane { normal: unit(*normal).unwrap_or(Vec3::Y), offset: *offset }
+                    Shape::Plane {
+                        normal: unit(*normal).unwrap_or(Vec3::Y),
+                        offset: *offset,
+                    }
                 }
-                NodeKind::Triangle { vertices: [a, b, c] } => {
-                    Shape::Triangle { vertices: [*a, *b, *c], normal: triangle_normal(*a, *b, *c) }
-                }
-                NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. } => Shape::Mesh(mesh.clone()),
-                NodeKind::TriangleMesh { mesh: MeshSlot::Failed(_) | MeshSlot::Unresolved, .. } => continue,
-                NodeKind::Box { min, max } => Shape::Box { min: *min, max: *max },
+                NodeKind::Triangle {
+                    vertices: [a, b, c],
+                } => Shape::Triangle {
+                    vertices: [*a, *b, *c],
+                    normal: triangle_normal(*a, *b, *c),
+                },
+                NodeKind::TriangleMesh {
+                    mesh: MeshSlot::Loaded(mesh),
+                    ..
+                } => Shape::Mesh(mesh.clone()),
+                NodeKind::TriangleMesh {
+                    mesh: MeshSlot::Failed(_) | MeshSlot::Unresolved,
+                    ..
+                } => continue,
+                NodeKind::Box { min, max } => Shape::Box {
+                    min: *min,
+                    max: *max,
+                },
                 NodeKind::Csg(_) => {
                     // One object for the whole subtree: its leaves keep their own transforms
                     // and materials, and its bounds go into the top-level BVH.
-                    let resolve = |m: Option<u32>| m.filter(|&i| i < n_mat).unwrap_or(default_material);
+                    let resolve =
+                        |m: Option<u32>| m.filter(|&i| i < n_mat).unwrap_or(default_material);
                     let tree = CsgTree::build(g, id, m, material, &resolve);
-                    objects.push(Object { shape: Shape::Csg(Arc::new(tree)), xf: None, material: resolve(material), node: id });
+                    objects.push(Object {
+                        shape: Shape::Csg(Arc::new(tree)),
+                        xf: None,
+                        material: resolve(material),
+                        node: id,
+                    });
                     continue;
                 }
             };
             let xf = (m != DMat4::IDENTITY).then(|| Transform::from_f64(m));
             let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
-            objects.push(Object { shape, xf, material, node: id });
+            objects.push(Object {
+                shape,
+                xf,
+                material,
+                node: id,
+            });
         }
 
         let mut bounded_boxes = Vec::new();
@@ -175,7 +216,11 @@ impl CompiledScene {
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
         {
-            return Self::mesh_hit(o, m, ray, t_min, t_max).map(|(t, prim)| Hit { t, object: i, prim });
+            return Self::mesh_hit(o, m, ray, t_min, t_max).map(|(t, prim)| Hit {
+                t,
+                object: i,
+                prim,
+            });
         }
         self.intersect_scene(ray, t_min, t_max)
     }
@@ -186,7 +231,13 @@ impl CompiledScene {
     /// top-level BVH once for the eight (`Bvh::traverse8`), meshes among its objects taking
     /// the lanes that reach them as a packet and other shapes one ray at a time.
     #[inline]
-    pub fn intersect8(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
+    pub fn intersect8(
+        &self,
+        rays: &[Ray; 8],
+        active: u8,
+        t_min: f32,
+        t_max: f32,
+    ) -> [Option<Hit>; 8] {
         self.intersect8_with(rays, active, t_min, t_max, false)
     }
 
@@ -194,15 +245,30 @@ impl CompiledScene {
     /// one ray at a time once it proves incoherent (`TriangleBvh::closest_hit8_with`). The
     /// same hits either way.
     #[inline(always)]
-    pub fn intersect8_with(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32, sparse: bool) -> [Option<Hit>; 8] {
+    pub fn intersect8_with(
+        &self,
+        rays: &[Ray; 8],
+        active: u8,
+        t_min: f32,
+        t_max: f32,
+        sparse: bool,
+    ) -> [Option<Hit>; 8] {
         if let Some(i) = self.single_mesh
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
         {
             let (org, dir) = Self::object_rays8(o, rays);
             let mut t = [t_max; 8];
-            let hits = m.accel.closest_hit8_with(&org, &dir, active, t_min, &mut t, sparse);
-            return hits.map(|h| h.map(|h| Hit { t: h.t, object: i, prim: h.triangle }));
+            let hits = m
+                .accel
+                .closest_hit8_with(&org, &dir, active, t_min, &mut t, sparse);
+            return hits.map(|h| {
+                h.map(|h| Hit {
+                    t: h.t,
+                    object: i,
+                    prim: h.triangle,
+                })
+            });
         }
         self.intersect_scene8(rays, active, t_min, t_max)
     }
@@ -216,12 +282,17 @@ impl CompiledScene {
                 let m = &xf.object_from_world;
                 // A perspective camera's rays share one origin: moved once, the same bits.
                 let origin = rays[0].origin;
-                let org = if rays.iter().all(|r| r.origin.to_array().map(f32::to_bits) == origin.to_array().map(f32::to_bits)) {
+                let org = if rays.iter().all(|r| {
+                    r.origin.to_array().map(f32::to_bits) == origin.to_array().map(f32::to_bits)
+                }) {
                     [m.transform_point3(origin).into(); 8]
                 } else {
                     std::array::from_fn(|k| m.transform_point3(rays[k].origin).into())
                 };
-                (org, std::array::from_fn(|k| m.transform_vector3(rays[k].direction).into()))
+                (
+                    org,
+                    std::array::from_fn(|k| m.transform_vector3(rays[k].direction).into()),
+                )
             }
             None => (
                 std::array::from_fn(|k| rays[k].origin.into()),
@@ -231,7 +302,13 @@ impl CompiledScene {
     }
 
     #[inline(never)]
-    fn intersect_scene8(&self, rays: &[Ray; 8], active: u8, t_min: f32, t_max: f32) -> [Option<Hit>; 8] {
+    fn intersect_scene8(
+        &self,
+        rays: &[Ray; 8],
+        active: u8,
+        t_min: f32,
+        t_max: f32,
+    ) -> [Option<Hit>; 8] {
         let mut best: [Option<Hit>; 8] = [None; 8];
         let mut t = [t_max; 8];
         for &i in &self.unbounded {
@@ -241,26 +318,34 @@ impl CompiledScene {
         }
         let org: [Vec3A; 8] = std::array::from_fn(|k| rays[k].origin.into());
         let dir: [Vec3A; 8] = std::array::from_fn(|k| rays[k].direction.into());
-        self.bvh.traverse8(&org, &dir, active, t_min, &mut t, |i, reach, t| {
-            let Some(o) = self.objects.get(i as usize) else { return };
-            if let Shape::Mesh(m) = &o.shape
-                && reach.count_ones() > 1
-            {
-                let (org, dir) = Self::object_rays8(o, rays);
-                let mut bound: [f32; 8] = std::array::from_fn(|k| tie_bound(i, t[k], best[k].as_ref()));
-                let hits = m.accel.closest_hit8(&org, &dir, reach, t_min, &mut bound);
-                for k in lanes(reach) {
-                    if let Some(h) = hits[k] {
-                        t[k] = h.t;
-                        best[k] = Some(Hit { t: h.t, object: i, prim: h.triangle });
+        self.bvh
+            .traverse8(&org, &dir, active, t_min, &mut t, |i, reach, t| {
+                let Some(o) = self.objects.get(i as usize) else {
+                    return;
+                };
+                if let Shape::Mesh(m) = &o.shape
+                    && reach.count_ones() > 1
+                {
+                    let (org, dir) = Self::object_rays8(o, rays);
+                    let mut bound: [f32; 8] =
+                        std::array::from_fn(|k| tie_bound(i, t[k], best[k].as_ref()));
+                    let hits = m.accel.closest_hit8(&org, &dir, reach, t_min, &mut bound);
+                    for k in lanes(reach) {
+                        if let Some(h) = hits[k] {
+                            t[k] = h.t;
+                            best[k] = Some(Hit {
+                                t: h.t,
+                                object: i,
+                                prim: h.triangle,
+                            });
+                        }
+                    }
+                } else {
+                    for k in lanes(reach) {
+                        self.offer(i, &rays[k], t_min, &mut t[k], &mut best[k]);
                     }
                 }
-            } else {
-                for k in lanes(reach) {
-                    self.offer(i, &rays[k], t_min, &mut t[k], &mut best[k]);
-                }
-            }
-        });
+            });
         best
     }
 
@@ -268,7 +353,9 @@ impl CompiledScene {
     /// over if it is nearer, or as near with a lower index (`tie_bound`).
     #[inline]
     fn offer(&self, i: u32, ray: &Ray, t_min: f32, t_best: &mut f32, best: &mut Option<Hit>) {
-        if let Some((t, prim)) = self.intersect_object(i, ray, t_min, tie_bound(i, *t_best, best.as_ref())) {
+        if let Some((t, prim)) =
+            self.intersect_object(i, ray, t_min, tie_bound(i, *t_best, best.as_ref()))
+        {
             *t_best = t;
             *best = Some(Hit { t, object: i, prim });
         }
@@ -286,7 +373,9 @@ impl CompiledScene {
             ),
             None => (ray.origin, ray.direction),
         };
-        m.accel.closest_hit(Vec3A::from(org), Vec3A::from(dir), t_min, t_max).map(|h| (h.t, h.triangle))
+        m.accel
+            .closest_hit(Vec3A::from(org), Vec3A::from(dir), t_min, t_max)
+            .map(|h| (h.t, h.triangle))
     }
 
     #[inline(never)]
@@ -296,17 +385,25 @@ impl CompiledScene {
         for &i in &self.unbounded {
             self.offer(i, ray, t_min, &mut t_best, &mut best);
         }
-        self.bvh.traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
-            let (t, prim) = self.intersect_object(i, ray, t_min, tie_bound(i, t_max, best.as_ref()))?;
-            best = Some(Hit { t, object: i, prim });
-            Some(t)
-        });
+        self.bvh
+            .traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
+                let (t, prim) =
+                    self.intersect_object(i, ray, t_min, tie_bound(i, t_max, best.as_ref()))?;
+                best = Some(Hit { t, object: i, prim });
+                Some(t)
+            });
         best
     }
 
     /// One object's closest hit: (t, triangle index).
     #[inline]
-    pub fn intersect_object(&self, i: u32, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
+    pub fn intersect_object(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, u32)> {
         let o = self.objects.get(i as usize)?;
         if let Shape::Mesh(m) = &o.shape {
             return Self::mesh_hit(o, m, ray, t_min, t_max);
@@ -325,7 +422,9 @@ impl CompiledScene {
 
     /// The object-space normal at a hit (not normalised for spheres' scale; unit otherwise).
     pub fn object_normal(&self, ray: &Ray, hit: &Hit) -> Vec3 {
-        let Some(o) = self.objects.get(hit.object as usize) else { return Vec3::Z };
+        let Some(o) = self.objects.get(hit.object as usize) else {
+            return Vec3::Z;
+        };
         match &o.shape {
             Shape::Sphere { center, .. } => {
                 let r = match &o.xf {
@@ -349,7 +448,12 @@ impl CompiledScene {
             return tree.world_normal(ray, hit.t, hit.prim, mode);
         }
         let n = self.object_normal(ray, hit);
-        mode.apply(self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()), n)
+        mode.apply(
+            self.objects
+                .get(hit.object as usize)
+                .and_then(|o| o.xf.as_ref()),
+            n,
+        )
     }
 
     pub fn object_count(&self) -> usize {
@@ -359,9 +463,12 @@ impl CompiledScene {
     /// The material index a hit shades with: a CSG surface keeps its operand's material.
     pub fn hit_material(&self, hit: &Hit) -> u32 {
         match self.objects.get(hit.object as usize) {
-            Some(Object { shape: Shape::Csg(tree), .. }) => {
-                tree.leaf(hit.prim).map_or(self.default_material(), |l| l.material)
-            }
+            Some(Object {
+                shape: Shape::Csg(tree),
+                ..
+            }) => tree
+                .leaf(hit.prim)
+                .map_or(self.default_material(), |l| l.material),
             Some(o) => o.material,
             None => self.default_material(),
         }
@@ -369,14 +476,21 @@ impl CompiledScene {
 
     /// The colour `hit_material` names.
     pub fn hit_color(&self, hit: &Hit) -> Vec3 {
-        self.materials.get(self.hit_material(hit) as usize).copied().unwrap_or(DEFAULT_MATERIAL_COLOR)
+        self.materials
+            .get(self.hit_material(hit) as usize)
+            .copied()
+            .unwrap_or(DEFAULT_MATERIAL_COLOR)
     }
 
     /// The scene node a hit belongs to: for a CSG surface, the operand it came from, so the
     /// pixel inspector and click-to-select find the Sphere or Box, not the Union.
     pub fn hit_node(&self, hit: &Hit) -> Option<NodeId> {
         match self.objects.get(hit.object as usize) {
-            Some(Object { shape: Shape::Csg(tree), node, .. }) => Some(tree.leaf(hit.prim).map_or(*node, |l| l.node)),
+            Some(Object {
+                shape: Shape::Csg(tree),
+                node,
+                ..
+            }) => Some(tree.leaf(hit.prim).map_or(*node, |l| l.node)),
             Some(o) => Some(o.node),
             None => None,
         }
@@ -399,14 +513,24 @@ impl CompiledScene {
 #[inline(always)]
 pub(super) fn shape_hit(shape: &Shape, r: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
     match shape {
-        Shape::Sphere { center, radius } => intersect_sphere(r, *center, *radius, t_min, t_max).map(|t| (t, 0)),
-        Shape::Plane { normal, offset } => intersect_plane(r, *normal, *offset, t_min, t_max).map(|t| (t, 0)),
-        Shape::Triangle { vertices: [a, b, c], .. } => {
-            intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0))
+        Shape::Sphere { center, radius } => {
+            intersect_sphere(r, *center, *radius, t_min, t_max).map(|t| (t, 0))
         }
+        Shape::Plane { normal, offset } => {
+            intersect_plane(r, *normal, *offset, t_min, t_max).map(|t| (t, 0))
+        }
+        Shape::Triangle {
+            vertices: [a, b, c],
+            ..
+        } => intersect_triangle(r, *a, *b, *c, t_min, t_max).map(|(t, _, _)| (t, 0)),
         Shape::Mesh(m) => m
             .accel
-            .closest_hit(Vec3A::from(r.origin), Vec3A::from(r.direction), t_min, t_max)
+            .closest_hit(
+                Vec3A::from(r.origin),
+                Vec3A::from(r.direction),
+                t_min,
+                t_max,
+            )
             .map(|h| (h.t, h.triangle)),
         Shape::Box { min, max } => {
             let (t0, f0, t1, f1) = box_span(r, *min, *max)?;
@@ -427,7 +551,11 @@ pub(super) fn shape_hit(shape: &Shape, r: &Ray, t_min: f32, t_max: f32) -> Optio
 /// on the same hit.
 #[inline(always)]
 pub(super) fn tie_bound(i: u32, t_best: f32, best: Option<&Hit>) -> f32 {
-    if best.is_some_and(|b| i < b.object) { t_best.next_up() } else { t_best }
+    if best.is_some_and(|b| i < b.object) {
+        t_best.next_up()
+    } else {
+        t_best
+    }
 }
 
 /// The lanes whose bit is set in `mask`.

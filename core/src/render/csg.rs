@@ -13,7 +13,9 @@ use glam::{DMat4, Vec3};
 
 use super::NormalTransform;
 use crate::accel::TriangleHit;
-use crate::geometry::{Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots};
+use crate::geometry::{
+    Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots,
+};
 use crate::scene::validate::compose_f64;
 use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
 
@@ -142,7 +144,9 @@ impl CsgTree {
                     // Exactly two operands; an edited scene may hold fewer, read as empty.
                     stack.push(Work::Emit(*op));
                     // Operands are a list: a MaterialIndex before A holds for B too.
-                    let listed = node.map(|n| graph.list_materials(n, material)).unwrap_or_default();
+                    let listed = node
+                        .map(|n| graph.list_materials(n, material))
+                        .unwrap_or_default();
                     let inherited = |i: usize| listed.get(i).map_or(material, |l| l.1);
                     stack.push(Work::Visit(children.get(1).copied(), m, inherited(1)));
                     stack.push(Work::Visit(children.first().copied(), m, inherited(0)));
@@ -153,12 +157,22 @@ impl CsgTree {
                     stack.push(Work::Visit(child, m * compose_f64(ops), material));
                     continue;
                 }
-                Some(NodeKind::Sphere { center, radius }) => Solid::Sphere { center: *center, radius: *radius },
-                Some(NodeKind::Box { min, max }) => Solid::Box { min: *min, max: *max },
-                Some(NodeKind::Plane { normal, offset }) => {
-                    Solid::HalfSpace { normal: unit(*normal).unwrap_or(Vec3::Y), offset: *offset }
-                }
-                Some(NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(mesh), .. }) => Solid::Mesh(mesh.clone()),
+                Some(NodeKind::Sphere { center, radius }) => Solid::Sphere {
+                    center: *center,
+                    radius: *radius,
+                },
+                Some(NodeKind::Box { min, max }) => Solid::Box {
+                    min: *min,
+                    max: *max,
+                },
+                Some(NodeKind::Plane { normal, offset }) => Solid::HalfSpace {
+                    normal: unit(*normal).unwrap_or(Vec3::Y),
+                    offset: *offset,
+                },
+                Some(NodeKind::TriangleMesh {
+                    mesh: MeshSlot::Loaded(mesh),
+                    ..
+                }) => Solid::Mesh(mesh.clone()),
                 // Groups, lone triangles and unloaded meshes bound no solid.
                 _ => Solid::Empty,
             };
@@ -171,7 +185,11 @@ impl CsgTree {
             });
         }
         let bounds = program_bounds(&program, &leaves);
-        CsgTree { leaves, program, bounds }
+        CsgTree {
+            leaves,
+            program,
+            bounds,
+        }
     }
 
     /// World-space bounds of the result (infinite when a half-space leaves it unbounded,
@@ -195,12 +213,20 @@ impl CsgTree {
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             self.evaluate(ray, &mut s);
-            s.heap.iter().find(|b| b.t > t_min && b.t < t_max && b.leaf().is_some()).map(|b| (b.t, b.code))
+            s.heap
+                .iter()
+                .find(|b| b.t > t_min && b.t < t_max && b.leaf().is_some())
+                .map(|b| (b.t, b.code))
         })
     }
 
     fn evaluate(&self, ray: &Ray, s: &mut Scratch) {
-        let Scratch { heap, starts, combined, hits } = s;
+        let Scratch {
+            heap,
+            starts,
+            combined,
+            hits,
+        } = s;
         heap.clear();
         starts.clear();
         for step in &self.program {
@@ -217,7 +243,9 @@ impl CsgTree {
                     }
                 }
                 Step::Op(op) => {
-                    let (Some(sb), Some(sa)) = (starts.pop(), starts.pop()) else { continue };
+                    let (Some(sb), Some(sa)) = (starts.pop(), starts.pop()) else {
+                        continue;
+                    };
                     combined.clear();
                     combine(op, &heap[sa..sb], &heap[sb..], combined);
                     heap.truncate(sa);
@@ -231,7 +259,9 @@ impl CsgTree {
     /// The normal of a hit with this code in its leaf's object space, unit length, flipped
     /// for B's surfaces exposed by a subtraction.
     pub fn object_normal(&self, ray: &Ray, t: f32, code: u32) -> Vec3 {
-        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
+        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else {
+            return Vec3::Z;
+        };
         let r = match &leaf.xf {
             Some(xf) => ray.transformed(&xf.object_from_world),
             None => *ray,
@@ -243,7 +273,9 @@ impl CsgTree {
     /// The world normal of a hit with this code, normalised, by the chosen rule (flipped as
     /// `object_normal` is: the flip commutes with either linear map).
     pub fn world_normal(&self, ray: &Ray, t: f32, code: u32, mode: NormalTransform) -> Vec3 {
-        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else { return Vec3::Z };
+        let Some(leaf) = self.leaves.get((code & LEAF_MASK) as usize) else {
+            return Vec3::Z;
+        };
         mode.apply(leaf.xf.as_ref(), self.object_normal(ray, t, code))
     }
 
@@ -256,9 +288,15 @@ fn program_bounds(program: &[Step], leaves: &[CsgLeaf]) -> Aabb {
     let mut stack: Vec<Aabb> = Vec::new();
     for step in program {
         match *step {
-            Step::Leaf(i) => stack.push(leaves.get(i as usize).map_or(Aabb::EMPTY, leaf_world_bounds)),
+            Step::Leaf(i) => stack.push(
+                leaves
+                    .get(i as usize)
+                    .map_or(Aabb::EMPTY, leaf_world_bounds),
+            ),
             Step::Op(op) => {
-                let (Some(b), Some(a)) = (stack.pop(), stack.pop()) else { continue };
+                let (Some(b), Some(a)) = (stack.pop(), stack.pop()) else {
+                    continue;
+                };
                 stack.push(match op {
                     CsgOp::Union => a.union(b),
                     CsgOp::Intersection => {
@@ -285,7 +323,13 @@ fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
 }
 
 /// Appends a leaf's sorted boundaries along the whole (object-space) ray.
-fn leaf_bounds(solid: &Solid, r: &Ray, leaf: u32, out: &mut Vec<Bound>, hits: &mut Vec<TriangleHit>) {
+fn leaf_bounds(
+    solid: &Solid,
+    r: &Ray,
+    leaf: u32,
+    out: &mut Vec<Bound>,
+    hits: &mut Vec<TriangleHit>,
+) {
     let mut span = |t0: f32, c0: u32, t1: f32, c1: u32| {
         // `!(t0 < t1)` also rejects NaN, which must never reach `combine`.
         if t0 < t1 {
@@ -323,7 +367,8 @@ fn leaf_bounds(solid: &Solid, r: &Ray, leaf: u32, out: &mut Vec<Bound>, hits: &m
         }
         Solid::Mesh(mesh) => {
             hits.clear();
-            mesh.accel.intersect_all(r, f32::NEG_INFINITY, f32::INFINITY, hits);
+            mesh.accel
+                .intersect_all(r, f32::NEG_INFINITY, f32::INFINITY, hits);
             hits.sort_by(|a, b| a.t.total_cmp(&b.t));
             // A ray through an edge or vertex meets several triangles at one t; keep one
             // crossing per facing there, so crossings still alternate in and out.
@@ -361,11 +406,18 @@ fn leaf_normal(solid: &Solid, r: &Ray, t: f32, exit: bool) -> Vec3 {
         Solid::HalfSpace { normal, .. } => *normal,
         Solid::Mesh(mesh) => {
             let mut hits = Vec::new();
-            mesh.accel.intersect_all(r, t.next_down(), t.next_up(), &mut hits);
-            let n = hits.first().map_or(Vec3::Z, |h| mesh.face_normal(h.triangle));
+            mesh.accel
+                .intersect_all(r, t.next_down(), t.next_up(), &mut hits);
+            let n = hits
+                .first()
+                .map_or(Vec3::Z, |h| mesh.face_normal(h.triangle));
             // Orient by the crossing, not the file's winding: out of the solid along the ray
             // at an exit, against it at an entry.
-            if (n.dot(r.direction) > 0.0) != exit { -n } else { n }
+            if (n.dot(r.direction) > 0.0) != exit {
+                -n
+            } else {
+                n
+            }
         }
         Solid::Empty => Vec3::Z,
     }
@@ -447,5 +499,4 @@ mod tests {
         combine(CsgOp::Subtraction, &a, &a, &mut out);
         assert!(out.is_empty());
     }
-
 }

@@ -15,7 +15,12 @@ pub struct Sample {
 }
 
 impl Sample {
-    pub const UNSET: Sample = Sample { color: [0; 3], normal: [0; 3], t: f32::INFINITY, node: u32::MAX };
+    pub const UNSET: Sample = Sample {
+        color: [0; 3],
+        normal: [0; 3],
+        t: f32::INFINITY,
+        node: u32::MAX,
+    };
     pub fn is_hit(&self) -> bool {
         self.node != u32::MAX
     }
@@ -53,14 +58,19 @@ pub fn depth_shade(t: f32, min: f32, max: f32) -> f32 {
 
 impl Frame {
     pub fn new(width: u32, height: u32) -> Self {
-        Frame { width, height, samples: vec![Sample::UNSET; width as usize * height as usize] }
+        Frame {
+            width,
+            height,
+            samples: vec![Sample::UNSET; width as usize * height as usize],
+        }
     }
 
     pub fn get(&self, x: u32, row: u32) -> Option<&Sample> {
         if x >= self.width || row >= self.height {
             return None;
         }
-        self.samples.get(row as usize * self.width as usize + x as usize)
+        self.samples
+            .get(row as usize * self.width as usize + x as usize)
     }
 
     /// RGB8 bytes of one view, rows top to bottom. `depth` is (min, max) for the depth view.
@@ -71,7 +81,11 @@ impl Frame {
                 View::Color => out.extend_from_slice(&s.color),
                 View::Normals => out.extend_from_slice(&s.normal),
                 View::Depth => {
-                    let g = if s.is_hit() { quantize(depth_shade(s.t, depth.0, depth.1)) } else { 0 };
+                    let g = if s.is_hit() {
+                        quantize(depth_shade(s.t, depth.0, depth.1))
+                    } else {
+                        0
+                    };
                     out.extend_from_slice(&[g, g, g]);
                 }
             }
@@ -89,7 +103,12 @@ impl Frame {
         out
     }
 
-    pub fn save(&self, view: View, depth: (f32, f32), path: &std::path::Path) -> Result<(), image::ImageError> {
+    pub fn save(
+        &self,
+        view: View,
+        depth: (f32, f32),
+        path: &std::path::Path,
+    ) -> Result<(), image::ImageError> {
         let img = image::RgbImage::from_raw(self.width, self.height, self.rgb8(view, depth))
             .expect("buffer size matches the frame");
         img.save(path)
@@ -141,14 +160,36 @@ mod tests {
     #[test]
     fn quantize3_is_quantize_for_every_input() {
         let mut xs = vec![
-            f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0, f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE, 1e-45, 1.0, 1.0 - f32::EPSILON, 1.0 + f32::EPSILON, 0.5, 254.5 / 255.0,
-            1.0 / 255.0, 0.999_999_9 / 255.0, f32::MAX, f32::MIN, 1e10, -1e10, 8_388_608.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            1e-45,
+            1.0,
+            1.0 - f32::EPSILON,
+            1.0 + f32::EPSILON,
+            0.5,
+            254.5 / 255.0,
+            1.0 / 255.0,
+            0.999_999_9 / 255.0,
+            f32::MAX,
+            f32::MIN,
+            1e10,
+            -1e10,
+            8_388_608.0,
         ];
         xs.extend((0..=200_000).map(|i| -0.5 + i as f32 * 1e-5));
         for w in xs.chunks(3) {
             let v = Vec3::new(w[0], *w.get(1).unwrap_or(&0.25), *w.get(2).unwrap_or(&-3.0));
-            assert_eq!(quantize3(v), [quantize(v.x), quantize(v.y), quantize(v.z)], "{v:?}");
+            assert_eq!(
+                quantize3(v),
+                [quantize(v.x), quantize(v.y), quantize(v.z)],
+                "{v:?}"
+            );
         }
     }
 }

@@ -117,7 +117,10 @@ pub fn inspect_pixel(
             let object_ray = path.last().map_or(world_ray, |s| s.ray);
             let ot = compiled.object_t(&world_ray, &hit, rule);
             // CSG operands carry their transforms inside the solid: they keep the plain rule.
-            let own_xf = compiled.objects.get(hit.object as usize).is_some_and(|o| o.xf.is_some());
+            let own_xf = compiled
+                .objects
+                .get(hit.object as usize)
+                .is_some_and(|o| o.xf.is_some());
             let traced_ray = if own_xf { ot.traced } else { object_ray };
             // The normal routines evaluate their ray at hit.t: give them one that lands on the
             // point really hit under every rule.
@@ -281,7 +284,11 @@ Group { numObjects 1
         // its own (unscaled) space, flipped inward.
         assert!(h.normal_correct.z > 0.0, "{:?}", h.normal_correct);
         let radial = (h.object_point - Vec3::ZERO).normalize();
-        assert!((h.object_normal + radial).length() < 1e-4, "{:?} vs {radial:?}", h.object_normal);
+        assert!(
+            (h.object_normal + radial).length() < 1e-4,
+            "{:?} vs {radial:?}",
+            h.object_normal
+        );
         let px = frame.get(22, 18).expect("in frame");
         let e = story.color();
         assert_eq!(px.color, [quantize(e.x), quantize(e.y), quantize(e.z)]);

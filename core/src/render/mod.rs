@@ -19,15 +19,15 @@ pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
-pub use object_rays::{ObjectRays, ObjectT};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
+pub use object_rays::{ObjectRays, ObjectT};
 pub use progressive::{
-    Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced, render_full, render_progressive,
-    render_progressive_traced,
+    Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced,
+    render_full, render_progressive, render_progressive_traced,
 };
-pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
+pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 
 /// How world normals are obtained from object-space ones under a Transform.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -20,7 +20,11 @@ pub enum ObjectRays {
 }
 
 impl ObjectRays {
-    pub const ALL: [ObjectRays; 3] = [ObjectRays::Unnormalized, ObjectRays::Normalized, ObjectRays::NormalizedNoRescale];
+    pub const ALL: [ObjectRays; 3] = [
+        ObjectRays::Unnormalized,
+        ObjectRays::Normalized,
+        ObjectRays::NormalizedNoRescale,
+    ];
 
     /// The spelling of `--object-rays`.
     pub fn name(self) -> &'static str {
@@ -55,24 +59,43 @@ pub struct ObjectT {
 impl CompiledScene {
     /// `intersect` under a rule. The default rule is the renderer's fast path; the others
     /// exist to be shown, so they trade speed for being plainly what the lecture describes.
-    pub fn intersect_with(&self, ray: &Ray, t_min: f32, t_max: f32, rule: ObjectRays) -> Option<Hit> {
+    pub fn intersect_with(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        rule: ObjectRays,
+    ) -> Option<Hit> {
         match rule {
             ObjectRays::Unnormalized => self.intersect(ray, t_min, t_max),
             ObjectRays::Normalized => {
                 let mut best = None;
                 let mut t_best = t_max;
                 for &i in &self.unbounded {
-                    if let Some((t, prim)) = self.intersect_object_with(i, ray, t_min, tie_bound(i, t_best, best.as_ref()), rule) {
+                    if let Some((t, prim)) = self.intersect_object_with(
+                        i,
+                        ray,
+                        t_min,
+                        tie_bound(i, t_best, best.as_ref()),
+                        rule,
+                    ) {
                         t_best = t;
                         best = Some(Hit { t, object: i, prim });
                     }
                 }
                 // World t throughout, so the object boxes may prune as usual.
-                self.bvh.traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
-                    let (t, prim) = self.intersect_object_with(i, ray, t_min, tie_bound(i, t_max, best.as_ref()), rule)?;
-                    best = Some(Hit { t, object: i, prim });
-                    Some(t)
-                });
+                self.bvh
+                    .traverse(ray.origin, ray.direction, t_min, t_best, |i, t_max| {
+                        let (t, prim) = self.intersect_object_with(
+                            i,
+                            ray,
+                            t_min,
+                            tie_bound(i, t_max, best.as_ref()),
+                            rule,
+                        )?;
+                        best = Some(Hit { t, object: i, prim });
+                        Some(t)
+                    });
                 best
             }
             ObjectRays::NormalizedNoRescale => {
@@ -82,7 +105,8 @@ impl CompiledScene {
                 let mut best: Option<Hit> = None;
                 for i in 0..self.objects.len() as u32 {
                     let t_max = best.map_or(t_max, |b| b.t);
-                    if let Some((t, prim)) = self.intersect_object_with(i, ray, t_min, t_max, rule) {
+                    if let Some((t, prim)) = self.intersect_object_with(i, ray, t_min, t_max, rule)
+                    {
                         best = Some(Hit { t, object: i, prim });
                     }
                 }
@@ -102,7 +126,9 @@ impl CompiledScene {
         rule: ObjectRays,
     ) -> Option<(f32, u32)> {
         let o = self.objects.get(i as usize)?;
-        let Some(xf) = &o.xf else { return shape_hit(&o.shape, ray, t_min, t_max) };
+        let Some(xf) = &o.xf else {
+            return shape_hit(&o.shape, ray, t_min, t_max);
+        };
         let local = ray.transformed(&xf.object_from_world);
         match rule {
             ObjectRays::Unnormalized => shape_hit(&o.shape, &local, t_min, t_max),
@@ -121,20 +147,39 @@ impl CompiledScene {
 
     /// For a hit found under `rule`, the object-space ray and t in both spaces.
     pub fn object_t(&self, ray: &Ray, hit: &Hit, rule: ObjectRays) -> ObjectT {
-        let xf = self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref());
+        let xf = self
+            .objects
+            .get(hit.object as usize)
+            .and_then(|o| o.xf.as_ref());
         let local = xf.map_or(*ray, |xf| ray.transformed(&xf.object_from_world));
-        let s = if xf.is_some() { local.direction.length() } else { 1.0 };
+        let s = if xf.is_some() {
+            local.direction.length()
+        } else {
+            1.0
+        };
         let unit = Ray::new(local.origin, local.direction / s);
         match (rule, xf) {
-            (ObjectRays::Unnormalized, _) | (_, None) => {
-                ObjectT { traced: local, direction_scale: s, t_object: hit.t, t_world: hit.t, t_used: hit.t }
-            }
-            (ObjectRays::Normalized, Some(_)) => {
-                ObjectT { traced: unit, direction_scale: s, t_object: hit.t * s, t_world: hit.t, t_used: hit.t }
-            }
-            (ObjectRays::NormalizedNoRescale, Some(_)) => {
-                ObjectT { traced: unit, direction_scale: s, t_object: hit.t, t_world: hit.t / s, t_used: hit.t }
-            }
+            (ObjectRays::Unnormalized, _) | (_, None) => ObjectT {
+                traced: local,
+                direction_scale: s,
+                t_object: hit.t,
+                t_world: hit.t,
+                t_used: hit.t,
+            },
+            (ObjectRays::Normalized, Some(_)) => ObjectT {
+                traced: unit,
+                direction_scale: s,
+                t_object: hit.t * s,
+                t_world: hit.t,
+                t_used: hit.t,
+            },
+            (ObjectRays::NormalizedNoRescale, Some(_)) => ObjectT {
+                traced: unit,
+                direction_scale: s,
+                t_object: hit.t,
+                t_world: hit.t / s,
+                t_used: hit.t,
+            },
         }
     }
 
@@ -146,9 +191,16 @@ impl CompiledScene {
         if rule != ObjectRays::NormalizedNoRescale {
             return *ray;
         }
-        match self.objects.get(hit.object as usize).and_then(|o| o.xf.as_ref()) {
+        match self
+            .objects
+            .get(hit.object as usize)
+            .and_then(|o| o.xf.as_ref())
+        {
             Some(xf) => {
-                let s = xf.object_from_world.transform_vector3(ray.direction).length();
+                let s = xf
+                    .object_from_world
+                    .transform_vector3(ray.direction)
+                    .length();
                 Ray::new(ray.origin, ray.direction / s)
             }
             None => *ray,

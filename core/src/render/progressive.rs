@@ -68,7 +68,11 @@ impl SharedFrame {
     /// Fraction of the current render's work done, in [0, 1].
     pub fn progress(&self) -> f32 {
         let total = self.tiles_total.load(Ordering::Relaxed);
-        if total == 0 { 0.0 } else { self.tiles_done.load(Ordering::Relaxed) as f32 / total as f32 }
+        if total == 0 {
+            0.0
+        } else {
+            self.tiles_done.load(Ordering::Relaxed) as f32 / total as f32
+        }
     }
     fn bump(&self) {
         self.version.fetch_add(1, Ordering::AcqRel);
@@ -112,14 +116,25 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut S
     } else {
         scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
     };
-    let shaded = hit.as_ref().map_or((glam::Vec3::ZERO, glam::Vec3::ZERO), |h| shade_fast(scene, &ray, h, s));
+    let shaded = hit
+        .as_ref()
+        .map_or((glam::Vec3::ZERO, glam::Vec3::ZERO), |h| {
+            shade_fast(scene, &ray, h, s)
+        });
     store_sample(scene, dst, hit.as_ref(), shaded);
 }
 
 /// Traces the grid points `pts` (grid coordinates of one tile's pass, in the order
 /// `points_to_trace` gives them: 4×2 neighbourhoods) eight rays at a time, storing each sample
 /// at its place in `grid` (row-major, `gw` points a row).
-fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, rays: &PixelRays, pts: &[(u32, u32)], grid: &mut [Sample]) {
+fn trace_packets(
+    scene: &CompiledScene,
+    s: &RenderSettings,
+    pass: &TilePass,
+    rays: &PixelRays,
+    pts: &[(u32, u32)],
+    grid: &mut [Sample],
+) {
     let t_min = scene.camera.t_min();
     // Every miss stores the same sample: quantise the background once, not per pixel.
     let mut miss = Sample::UNSET;
@@ -131,7 +146,13 @@ fn trace_packets(scene: &CompiledScene, s: &RenderSettings, pass: &TilePass, ray
             r[k] = rays.row(row).ray(x);
         }
         let active = ((1u16 << chunk.len()) - 1) as u8;
-        let hits = scene.intersect8_with(&r, active, t_min, f32::INFINITY, pass.scale >= SPARSE_FROM_SCALE);
+        let hits = scene.intersect8_with(
+            &r,
+            active,
+            t_min,
+            f32::INFINITY,
+            pass.scale >= SPARSE_FROM_SCALE,
+        );
         let shaded = shade_packet(scene, &r, &hits, s);
         for (k, &(i, j)) in chunk.iter().enumerate() {
             let dst = &mut grid[pass.index(i, j)];
@@ -197,14 +218,25 @@ impl TilePass {
 
 /// Stores a pixel's sample, hit or miss, into `dst`.
 #[inline(always)]
-fn store_sample(scene: &CompiledScene, dst: &mut Sample, hit: Option<&super::compile::Hit>, (c, n): (glam::Vec3, glam::Vec3)) {
+fn store_sample(
+    scene: &CompiledScene,
+    dst: &mut Sample,
+    hit: Option<&super::compile::Hit>,
+    (c, n): (glam::Vec3, glam::Vec3),
+) {
     match hit {
         Some(hit) => {
             // The operand, for a CSG surface: what the pixel inspector and picking show.
             let node = scene.hit_node(hit).map_or(u32::MAX, |n| n.0);
             write_sample(dst, c, n, hit.t, node);
         }
-        None => write_sample(dst, scene.background, glam::Vec3::ZERO, f32::INFINITY, u32::MAX),
+        None => write_sample(
+            dst,
+            scene.background,
+            glam::Vec3::ZERO,
+            f32::INFINITY,
+            u32::MAX,
+        ),
     }
 }
 
@@ -217,7 +249,16 @@ pub fn render_progressive(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, Some(STRAIGHT_TO_FULL_BELOW), Tracing::default(), &mut on_pass)
+    render_scales(
+        scene,
+        settings,
+        target,
+        cancel,
+        &SCALES,
+        Some(STRAIGHT_TO_FULL_BELOW),
+        Tracing::default(),
+        &mut on_pass,
+    )
 }
 
 /// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
@@ -229,7 +270,16 @@ pub fn render_coarse(
     cancel: &AtomicBool,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES[..2], None, Tracing::default(), &mut on_pass)
+    render_scales(
+        scene,
+        settings,
+        target,
+        cancel,
+        &SCALES[..2],
+        None,
+        Tracing::default(),
+        &mut on_pass,
+    )
 }
 
 /// Renders the full-resolution image in one pass.
@@ -238,10 +288,23 @@ pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
 }
 
 /// [`render_frame`] with the primary rays traced as `tracing` says.
-pub fn render_frame_traced(scene: &CompiledScene, settings: &RenderSettings, tracing: Tracing) -> Frame {
+pub fn render_frame_traced(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    tracing: Tracing,
+) -> Frame {
     let target = SharedFrame::new();
     let never = AtomicBool::new(false);
-    let _ = render_scales(scene, settings, &target, &never, &[1], None, tracing, &mut |_| {});
+    let _ = render_scales(
+        scene,
+        settings,
+        &target,
+        &never,
+        &[1],
+        None,
+        tracing,
+        &mut |_| {},
+    );
     std::mem::replace(&mut *target.lock(), Frame::new(0, 0))
 }
 
@@ -255,7 +318,16 @@ pub fn render_progressive_traced(
     tracing: Tracing,
     mut on_pass: impl FnMut(PassInfo),
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &SCALES, Some(STRAIGHT_TO_FULL_BELOW), tracing, &mut on_pass)
+    render_scales(
+        scene,
+        settings,
+        target,
+        cancel,
+        &SCALES,
+        Some(STRAIGHT_TO_FULL_BELOW),
+        tracing,
+        &mut on_pass,
+    )
 }
 
 /// One full-resolution pass into `target` (which others may watch for progress).
@@ -265,7 +337,16 @@ pub fn render_full(
     target: &SharedFrame,
     cancel: &AtomicBool,
 ) -> Result<(), Cancelled> {
-    render_scales(scene, settings, target, cancel, &[1], None, Tracing::default(), &mut |_| {})
+    render_scales(
+        scene,
+        settings,
+        target,
+        cancel,
+        &[1],
+        None,
+        Tracing::default(),
+        &mut |_| {},
+    )
 }
 
 /// The grid points of a tile's pass not traced before, in 4×2 neighbourhoods (two rows, four
@@ -290,7 +371,14 @@ fn points_to_trace(pass: &TilePass) -> Vec<(u32, u32)> {
 /// every grid point's sample over its scale×scale block. The points traced before are read
 /// back from the band (their blocks hold them), so each grid row expands to one pixel row that
 /// is then copied to the block's rows.
-fn write_tile(band: &mut [Sample], w: usize, band_y0: u32, pass: &TilePass, grid: &mut [Sample], line: &mut Vec<Sample>) {
+fn write_tile(
+    band: &mut [Sample],
+    w: usize,
+    band_y0: u32,
+    pass: &TilePass,
+    grid: &mut [Sample],
+    line: &mut Vec<Sample>,
+) {
     let (x0, x1) = (pass.x0 as usize, pass.x1 as usize);
     let s = pass.scale as usize;
     line.resize(x1 - x0, Sample::UNSET);
@@ -319,7 +407,14 @@ fn write_tile(band: &mut [Sample], w: usize, band_y0: u32, pass: &TilePass, grid
 
 /// Traces one tile's pass into a grid of its samples (the points traced before left unset,
 /// or, in a tile no ray can hit anything in, background like the rest).
-fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays, tracing: Tracing, cull: &TileCull, tp: &TilePass) -> Vec<Sample> {
+fn trace_tile(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    rays: &PixelRays,
+    tracing: Tracing,
+    cull: &TileCull,
+    tp: &TilePass,
+) -> Vec<Sample> {
     // Packets only: the single rays trace every pixel, so that the two agreeing shows that
     // no culled pixel would have hit.
     if tracing == Tracing::Packets && !cull.may_hit((tp.x0, tp.y0, tp.x1, tp.y1)) {
@@ -338,7 +433,12 @@ fn trace_tile(scene: &CompiledScene, settings: &RenderSettings, rays: &PixelRays
                 let row_rays = rays.row(tp.pixel(0, j).1);
                 for i in 0..tp.gw {
                     if !tp.traced_before(i, j) {
-                        trace_sample(scene, settings, row_rays.ray(tp.pixel(i, j).0), &mut grid[tp.index(i, j)]);
+                        trace_sample(
+                            scene,
+                            settings,
+                            row_rays.ray(tp.pixel(i, j).0),
+                            &mut grid[tp.index(i, j)],
+                        );
                     }
                 }
             }
@@ -360,7 +460,13 @@ const SPARSE_FROM_SCALE: u32 = 4;
 /// How many passes to skip after pass `pass` of `plan`, which took `took`: those between it
 /// and the full-resolution pass that ends the plan, when the full pass's rays would take
 /// less than `below` at this pass's time per ray.
-fn passes_to_skip(plan: &[u32], pass: usize, took: Duration, (w, h): (u32, u32), below: Option<Duration>) -> usize {
+fn passes_to_skip(
+    plan: &[u32],
+    pass: usize,
+    took: Duration,
+    (w, h): (u32, u32),
+    below: Option<Duration>,
+) -> usize {
     let Some(below) = below else { return 0 };
     let between = plan.len().saturating_sub(pass + 2);
     if between == 0 || plan.last() != Some(&1) {
@@ -370,7 +476,11 @@ fn passes_to_skip(plan: &[u32], pass: usize, took: Duration, (w, h): (u32, u32),
     let points = |s: u32| f64::from(w.div_ceil(s)) * f64::from(h.div_ceil(s));
     let traced = points(plan[pass]) - pass.checked_sub(1).map_or(0.0, |p| points(plan[p]));
     let left = f64::from(w) * f64::from(h) - points(plan[pass]);
-    if traced > 0.0 && took.as_secs_f64() / traced * left < below.as_secs_f64() { between } else { 0 }
+    if traced > 0.0 && took.as_secs_f64() / traced * left < below.as_secs_f64() {
+        between
+    } else {
+        0
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -401,9 +511,13 @@ fn render_scales(
     let cull = TileCull::new(scene, w, h);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let tiles: Vec<(u32, u32)> = (0..tiles_y)
+        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+        .collect();
     target.tiles_done.store(0, Ordering::Relaxed);
-    target.tiles_total.store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
+    target
+        .tiles_total
+        .store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
     let mut plan = scales.to_vec();
     let mut pass = 0;
     while let Some(&scale) = plan.get(pass) {
@@ -411,7 +525,11 @@ fn render_scales(
         let coarser = (pass > 0).then(|| plan[pass - 1]);
         let tile_pass = |&(tx, ty): &(u32, u32)| {
             let (x0, y0) = (tx * TILE, ty * TILE);
-            TilePass::new((x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)), scale, coarser)
+            TilePass::new(
+                (x0, y0, (x0 + TILE).min(w), (y0 + TILE).min(h)),
+                scale,
+                coarser,
+            )
         };
         if scale >= WRITE_WHOLE_FROM_SCALE {
             let traced: Vec<(TilePass, Vec<Sample>)> = tiles
@@ -426,7 +544,8 @@ fn render_scales(
                     Ok((tp, grid))
                 })
                 .collect::<Result<_, _>>()?;
-            let mut bands: Vec<Vec<(TilePass, Vec<Sample>)>> = (0..tiles_y).map(|_| Vec::new()).collect();
+            let mut bands: Vec<Vec<(TilePass, Vec<Sample>)>> =
+                (0..tiles_y).map(|_| Vec::new()).collect();
             for (tp, grid) in traced {
                 bands[(tp.y0 / TILE) as usize].push((tp, grid));
             }
@@ -436,12 +555,16 @@ fn render_scales(
             // renders never share a frame at once (the editor gives each render fresh ones).
             let mut f = target.lock();
             let band_len = (w * TILE) as usize;
-            f.samples.par_chunks_mut(band_len).zip(bands.par_iter_mut()).enumerate().for_each(|(b, (band, tiles))| {
-                let mut line = Vec::with_capacity(TILE as usize);
-                for (tp, grid) in tiles {
-                    write_tile(band, w as usize, b as u32 * TILE, tp, grid, &mut line);
-                }
-            });
+            f.samples
+                .par_chunks_mut(band_len)
+                .zip(bands.par_iter_mut())
+                .enumerate()
+                .for_each(|(b, (band, tiles))| {
+                    let mut line = Vec::with_capacity(TILE as usize);
+                    for (tp, grid) in tiles {
+                        write_tile(band, w as usize, b as u32 * TILE, tp, grid, &mut line);
+                    }
+                });
             drop(f);
             target.bump();
         } else {
@@ -452,18 +575,38 @@ fn render_scales(
                 let tp = tile_pass(t);
                 let mut grid = trace_tile(scene, settings, &rays, tracing, &cull, &tp);
                 let mut line = Vec::with_capacity(TILE as usize);
-                write_tile(&mut target.lock().samples, w as usize, 0, &tp, &mut grid, &mut line);
+                write_tile(
+                    &mut target.lock().samples,
+                    w as usize,
+                    0,
+                    &tp,
+                    &mut grid,
+                    &mut line,
+                );
                 target.tiles_done.fetch_add(1, Ordering::Relaxed);
                 target.bump();
                 Ok(())
             })?;
         }
-        let skip = passes_to_skip(&plan, pass, pass_start.elapsed(), (w, h), straight_to_full_below);
+        let skip = passes_to_skip(
+            &plan,
+            pass,
+            pass_start.elapsed(),
+            (w, h),
+            straight_to_full_below,
+        );
         if skip > 0 {
             plan.drain(pass + 1..pass + 1 + skip);
-            target.tiles_total.store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
+            target
+                .tiles_total
+                .store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
         }
-        on_pass(PassInfo { pass, passes: plan.len(), scale, elapsed: start.elapsed() });
+        on_pass(PassInfo {
+            pass,
+            passes: plan.len(),
+            scale,
+            elapsed: start.elapsed(),
+        });
         pass += 1;
     }
     Ok(())
@@ -482,13 +625,20 @@ mod tests {
     /// grid), or a full pass after the 4× one.
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/nested_transforms.txt");
-        let scene = load_scene(&path, &mut MeshCache::new()).into_result().expect("scene loads").0;
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/nested_transforms.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
         let c = CompiledScene::new(&scene);
         for (w, h) in [(150u32, 97u32), (64, 64), (7, 130)] {
             let s = RenderSettings::new(w, h);
             let full = render_frame(&c, &s);
-            assert!(full.samples.iter().any(Sample::is_hit) && full.samples.iter().any(|p| !p.is_hit()), "{w}x{h}");
+            assert!(
+                full.samples.iter().any(Sample::is_hit) && full.samples.iter().any(|p| !p.is_hit()),
+                "{w}x{h}"
+            );
             for tracing in [Tracing::Packets, Tracing::SingleRays] {
                 // (plan, bound, the passes shown, PassInfo::passes after each)
                 let plans: [(&[u32], _, &[u32], &[usize]); 3] = [
@@ -510,7 +660,11 @@ mod tests {
                         for y in 0..h {
                             for x in 0..w {
                                 let corner = full.get(x - x % scale, y - y % scale);
-                                assert_eq!(f.get(x, y), corner, "{w}x{h} {tracing:?} {skip:?} after the {scale}× pass, pixel ({x}, {y})");
+                                assert_eq!(
+                                    f.get(x, y),
+                                    corner,
+                                    "{w}x{h} {tracing:?} {skip:?} after the {scale}× pass, pixel ({x}, {y})"
+                                );
                             }
                         }
                     }
@@ -539,8 +693,16 @@ mod tests {
         assert_eq!(skip(&SCALES, 1, ms(12), (3840, 2160)), 1);
         assert_eq!(skip(&SCALES, 1, ms(13), (3840, 2160)), 0);
         assert_eq!(passes_to_skip(&SCALES, 0, ms(1), (800, 800), None), 0);
-        assert_eq!(skip(&SCALES, 2, ms(1), (800, 800)), 0, "nothing between 2× and 1×");
-        assert_eq!(skip(&SCALES[..2], 0, ms(1), (800, 800)), 0, "the coarse passes alone");
+        assert_eq!(
+            skip(&SCALES, 2, ms(1), (800, 800)),
+            0,
+            "nothing between 2× and 1×"
+        );
+        assert_eq!(
+            skip(&SCALES[..2], 0, ms(1), (800, 800)),
+            0,
+            "the coarse passes alone"
+        );
         assert_eq!(skip(&[8, 4, 1], 0, ms(1), (800, 800)), 1);
         assert_eq!(skip(&[1], 0, ms(1), (800, 800)), 0, "one full pass");
     }
@@ -548,8 +710,12 @@ mod tests {
     /// A cancel before a pass is written leaves the frame as the last pass left it.
     #[test]
     fn a_cancelled_render_stops_without_writing_the_pass() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/perspective_mesh.txt");
-        let scene = load_scene(&path, &mut MeshCache::new()).into_result().expect("scene loads").0;
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/perspective_mesh.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
         let c = CompiledScene::new(&scene);
         let s = RenderSettings::new(130, 70);
         let target = SharedFrame::new();

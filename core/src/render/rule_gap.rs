@@ -6,12 +6,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::Mat3;
 use rayon::prelude::*;
 
+use super::NormalTransform;
 use super::RenderSettings;
 use super::compile::{CompiledScene, Hit, Object, Shape};
-use crate::geometry::Transform;
-use super::similitude::similitude_within;
-use super::NormalTransform;
 use super::progressive::Cancelled;
+use super::similitude::similitude_within;
+use crate::geometry::Transform;
 
 /// f32 matrices carry about seven digits: closer than this to a similitude is one.
 const F32_TOLERANCE: f64 = 1e-6;
@@ -29,10 +29,18 @@ pub struct NormalGap {
 /// by the theorem, (M⁻¹)ᵀ = λM, rather than the rounding of two f32 products.
 ///
 /// Stops within a row once `cancel` is set (the editor computes it after each render).
-pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings, cancel: &AtomicBool) -> Result<NormalGap, Cancelled> {
+pub fn normal_rule_gap(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    cancel: &AtomicBool,
+) -> Result<NormalGap, Cancelled> {
     let (w, h) = (settings.width, settings.height);
     let rays = scene.camera.pixel_rays(w, h);
-    let similar: Vec<bool> = scene.objects.iter().map(|o| object_is_similitude(o)).collect();
+    let similar: Vec<bool> = scene
+        .objects
+        .iter()
+        .map(|o| object_is_similitude(o))
+        .collect();
     (0..h)
         .into_par_iter()
         .map(|row| {
@@ -43,8 +51,12 @@ pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings, cancel:
             let mut best = NormalGap::default();
             for x in 0..w {
                 let ray = row_rays.ray(x);
-                let Some(hit) = scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, settings.object_rays)
-                else {
+                let Some(hit) = scene.intersect_with(
+                    &ray,
+                    scene.camera.t_min(),
+                    f32::INFINITY,
+                    settings.object_rays,
+                ) else {
                     continue;
                 };
                 if hit_is_similitude(scene, &similar, &hit) {
@@ -55,12 +67,17 @@ pub fn normal_rule_gap(scene: &CompiledScene, settings: &RenderSettings, cancel:
                 let b = scene.world_normal(&at, &hit, NormalTransform::Incorrect);
                 let deg = a.cross(b).length().atan2(a.dot(b)).to_degrees();
                 if deg > best.degrees {
-                    best = NormalGap { degrees: deg, pixel: Some((x, row)) };
+                    best = NormalGap {
+                        degrees: deg,
+                        pixel: Some((x, row)),
+                    };
                 }
             }
             Ok(best)
         })
-        .try_reduce(NormalGap::default, |a, b| Ok(if b.degrees > a.degrees { b } else { a }))
+        .try_reduce(NormalGap::default, |a, b| {
+            Ok(if b.degrees > a.degrees { b } else { a })
+        })
 }
 
 fn xf_is_similitude(xf: Option<&Transform>) -> bool {
@@ -83,7 +100,9 @@ fn hit_is_similitude(scene: &CompiledScene, similar: &[bool], hit: &Hit) -> bool
         return true;
     }
     match scene.objects.get(hit.object as usize).map(|o| &o.shape) {
-        Some(Shape::Csg(tree)) => tree.leaf(hit.prim).is_some_and(|l| xf_is_similitude(l.xf.as_ref())),
+        Some(Shape::Csg(tree)) => tree
+            .leaf(hit.prim)
+            .is_some_and(|l| xf_is_similitude(l.xf.as_ref())),
         _ => false,
     }
 }
@@ -106,15 +125,25 @@ Group {{ numObjects 2 MaterialIndex 0
   Transform {{ {ops} Sphere {{ center 0 0 0 radius 1 }} }}
   Transform {{ Translate 0 -1.5 0 XRotate 30 UniformScale 0.5 Box {{ min -1 -1 -1 max 1 1 1 }} }} }}"
         );
-        parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new()).into_result().expect("parses").0
+        parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("parses")
+            .0
     }
 
     #[test]
     fn only_similitudes_on_screen_give_exactly_zero() {
         let s = scene("ZRotate 20 UniformScale 1.3 XRotate 70 Scale -1 1 1");
         let c = CompiledScene::new(&s);
-        let gap = normal_rule_gap(&c, &RenderSettings::new(32, 32), &AtomicBool::new(false)).expect("not cancelled");
-        assert_eq!(gap, NormalGap { degrees: 0.0, pixel: None });
+        let gap = normal_rule_gap(&c, &RenderSettings::new(32, 32), &AtomicBool::new(false))
+            .expect("not cancelled");
+        assert_eq!(
+            gap,
+            NormalGap {
+                degrees: 0.0,
+                pixel: None
+            }
+        );
     }
 
     #[test]
@@ -123,7 +152,10 @@ Group {{ numObjects 2 MaterialIndex 0
         let c = CompiledScene::new(&s);
         let settings = RenderSettings::new(32, 32);
         let gap = normal_rule_gap(&c, &settings, &AtomicBool::new(false)).expect("not cancelled");
-        assert_eq!(normal_rule_gap(&c, &settings, &AtomicBool::new(true)), Err(Cancelled));
+        assert_eq!(
+            normal_rule_gap(&c, &settings, &AtomicBool::new(true)),
+            Err(Cancelled)
+        );
         // Independently: the pixel inspector's angle at every pixel.
         let mut best = 0.0f32;
         for row in 0..32 {
@@ -136,7 +168,9 @@ Group {{ numObjects 2 MaterialIndex 0
         assert!(gap.degrees > 10.0, "{gap:?}");
         assert!((gap.degrees - best).abs() < 1e-3, "{gap:?} vs {best}");
         let (x, row) = gap.pixel.expect("where");
-        let h = inspect_pixel(&s, &c, &settings, x, row).hit.expect("hit there");
+        let h = inspect_pixel(&s, &c, &settings, x, row)
+            .hit
+            .expect("hit there");
         assert!((h.normal_angle_degrees - gap.degrees).abs() < 1e-3);
     }
 }

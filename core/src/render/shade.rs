@@ -3,8 +3,8 @@
 
 use glam::Vec3;
 
-use super::compile::{CompiledScene, Hit};
 use super::RenderSettings;
+use super::compile::{CompiledScene, Hit};
 use crate::geometry::Ray;
 
 /// One light's share of a pixel, for the pixel inspector.
@@ -30,7 +30,12 @@ pub struct ShadeInfo {
     pub color: Vec3,
 }
 
-pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> ShadeInfo {
+pub fn shade_hit(
+    scene: &CompiledScene,
+    ray: &Ray,
+    hit: &Hit,
+    settings: &RenderSettings,
+) -> ShadeInfo {
     let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
     let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);
     let kd = scene.hit_color(hit);
@@ -58,7 +63,11 @@ pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderS
         let d = l.dot(n);
         let contribution = d.max(0.0) * color * kd;
         c += contribution;
-        info.lights.push(LightTerm { l, l_dot_n: d, contribution });
+        info.lights.push(LightTerm {
+            l,
+            l_dot_n: d,
+            contribution,
+        });
     }
     info.color = c;
     info
@@ -66,7 +75,12 @@ pub fn shade_hit(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderS
 
 /// Colour only, without collecting terms (the hot path).
 #[inline]
-pub(super) fn shade_fast(scene: &CompiledScene, ray: &Ray, hit: &Hit, settings: &RenderSettings) -> (Vec3, Vec3) {
+pub(super) fn shade_fast(
+    scene: &CompiledScene,
+    ray: &Ray,
+    hit: &Hit,
+    settings: &RenderSettings,
+) -> (Vec3, Vec3) {
     // The normal at the point really hit, whatever t the depth rule kept.
     let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
     let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);

@@ -59,13 +59,24 @@ fn shade_packet_with(
         let o = scene.objects.get(hit.object as usize);
         match o.map(|o| &o.shape) {
             Some(Shape::Mesh(m)) if settings.object_rays == ObjectRays::Unnormalized => {
-                input.set(k, rays[k].direction, m.triangle(hit.prim), scene.hit_color(hit));
+                input.set(
+                    k,
+                    rays[k].direction,
+                    m.triangle(hit.prim),
+                    scene.hit_color(hit),
+                );
                 let xf = o.and_then(|o| o.xf.as_ref());
                 match (xf, settings.normal_transform) {
                     (None, _) => {}
-                    (Some(xf), NormalTransform::Correct) => input.set_matrix(k, xf.normal_from_object.to_cols_array()),
+                    (Some(xf), NormalTransform::Correct) => {
+                        input.set_matrix(k, xf.normal_from_object.to_cols_array())
+                    }
                     (Some(xf), NormalTransform::Incorrect) => {
-                        let (x, y, z) = (xf.world_from_object.x_axis, xf.world_from_object.y_axis, xf.world_from_object.z_axis);
+                        let (x, y, z) = (
+                            xf.world_from_object.x_axis,
+                            xf.world_from_object.y_axis,
+                            xf.world_from_object.z_axis,
+                        );
                         input.set_matrix(k, [x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z]);
                     }
                 }
@@ -108,7 +119,13 @@ struct Input {
 impl Input {
     fn set(&mut self, k: usize, dir: Vec3, [a, b, c]: [Vec3; 3], kd: Vec3) {
         self.lanes |= 1 << k;
-        for (v, p) in [(&mut self.dir, dir), (&mut self.a, a), (&mut self.b, b), (&mut self.c, c), (&mut self.kd, kd)] {
+        for (v, p) in [
+            (&mut self.dir, dir),
+            (&mut self.a, a),
+            (&mut self.b, b),
+            (&mut self.c, c),
+            (&mut self.kd, kd),
+        ] {
             (v.x[k], v.y[k], v.z[k]) = (p.x, p.y, p.z);
         }
     }
@@ -160,9 +177,19 @@ fn normalize_or(v: &V3, fallback: &V3) -> V3 {
     let rcp = map(|k| 1.0 / d[k].sqrt());
     // Finite and positive, as 0 < r < ∞ (false for NaN): two compares and an and, where
     // `is_finite() && > 0.0` compiled to a branch per lane.
-    let ok = map(|k| if (rcp[k] > 0.0) & (rcp[k] < f32::INFINITY) { 1.0 } else { 0.0 });
+    let ok = map(|k| {
+        if (rcp[k] > 0.0) & (rcp[k] < f32::INFINITY) {
+            1.0
+        } else {
+            0.0
+        }
+    });
     let pick = |v: &Lanes, f: &Lanes| map(|k| if ok[k] != 0.0 { v[k] * rcp[k] } else { f[k] });
-    V3 { x: pick(&v.x, &fallback.x), y: pick(&v.y, &fallback.y), z: pick(&v.z, &fallback.z) }
+    V3 {
+        x: pick(&v.x, &fallback.x),
+        y: pick(&v.y, &fallback.y),
+        z: pick(&v.z, &fallback.z),
+    }
 }
 
 #[inline(always)]
@@ -183,17 +210,34 @@ fn lanes(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool
     // The normal matrix times n: (x_axis·n.x + y_axis·n.y) + z_axis·n.z, both rules' order
     // (`Mat3::mul_vec3`, and `Mat4::transform_vector3` up to the commuted first sum).
     let m = &input.m;
-    let row = |i: usize| map(|k| (m[i][k] * n_obj.x[k]) + (m[3 + i][k] * n_obj.y[k]) + (m[6 + i][k] * n_obj.z[k]));
-    let moved = normalize_or(&V3 { x: row(0), y: row(1), z: row(2) }, &n_obj);
+    let row = |i: usize| {
+        map(|k| (m[i][k] * n_obj.x[k]) + (m[3 + i][k] * n_obj.y[k]) + (m[6 + i][k] * n_obj.z[k]))
+    };
+    let moved = normalize_or(
+        &V3 {
+            x: row(0),
+            y: row(1),
+            z: row(2),
+        },
+        &n_obj,
+    );
     let t = &input.transformed;
     let keep = |a: &Lanes, b: &Lanes| map(|k| if t[k] != 0.0 { a[k] } else { b[k] });
-    let normal = V3 { x: keep(&moved.x, &n_obj.x), y: keep(&moved.y, &n_obj.y), z: keep(&moved.z, &n_obj.z) };
+    let normal = V3 {
+        x: keep(&moved.x, &n_obj.x),
+        y: keep(&moved.y, &n_obj.y),
+        z: keep(&moved.z, &n_obj.z),
+    };
 
     // `shade::lit`: black for a back face unless shade_back turns the normal to the eye.
     let facing = dot(&input.dir, &normal);
     let back = map(|k| if facing[k] > 0.0 { 1.0 } else { 0.0 });
     let flip = |v: &Lanes| map(|k| if back[k] != 0.0 { -v[k] } else { v[k] });
-    let n = V3 { x: flip(&normal.x), y: flip(&normal.y), z: flip(&normal.z) };
+    let n = V3 {
+        x: flip(&normal.x),
+        y: flip(&normal.y),
+        z: flip(&normal.z),
+    };
     let kd = &input.kd;
     let mut c = V3 {
         x: map(|k| ambient.x * kd.x[k]),
@@ -211,7 +255,14 @@ fn lanes(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool
         return Shaded { color: c, normal };
     }
     let black = |v: &Lanes| map(|k| if back[k] != 0.0 { 0.0 } else { v[k] });
-    Shaded { color: V3 { x: black(&c.x), y: black(&c.y), z: black(&c.z) }, normal }
+    Shaded {
+        color: V3 {
+            x: black(&c.x),
+            y: black(&c.y),
+            z: black(&c.z),
+        },
+        normal,
+    }
 }
 
 #[cfg(test)]
@@ -225,7 +276,12 @@ mod tests {
     }
 
     #[cfg(target_arch = "x86_64")]
-    fn run_avx_here(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool) -> Shaded {
+    fn run_avx_here(
+        input: &Input,
+        ambient: Vec3,
+        lights: &[(Vec3, Vec3)],
+        shade_back: bool,
+    ) -> Shaded {
         assert!(std::arch::is_x86_feature_detected!("avx"));
         #[allow(unsafe_code)]
         // SAFETY: the CPU has AVX, asserted just above.
@@ -243,8 +299,12 @@ mod tests {
     /// and uneven colours, under both normal rules, with and without shade_back.
     #[test]
     fn both_builds_equal_shade_fast_bit_for_bit() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/perspective_mesh.txt");
-        let scene = load_scene(&path, &mut MeshCache::new()).into_result().expect("scene loads").0;
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/perspective_mesh.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
         let c = CompiledScene::new(&scene);
         let (w, h) = (96u32, 72u32);
         let rays = c.camera.pixel_rays(w, h);
@@ -256,24 +316,39 @@ mod tests {
         let mut mesh_lanes = 0;
         for normal_transform in [NormalTransform::Correct, NormalTransform::Incorrect] {
             for shade_back in [false, true] {
-                let s = RenderSettings { shade_back, normal_transform, ..RenderSettings::new(w, h) };
+                let s = RenderSettings {
+                    shade_back,
+                    normal_transform,
+                    ..RenderSettings::new(w, h)
+                };
                 for row in (0..h).step_by(2) {
                     for x in (0..w).step_by(4) {
-                        let r: [Ray; N] = std::array::from_fn(|k| rays.row(row + k as u32 / 4).ray(x + k as u32 % 4));
+                        let r: [Ray; N] = std::array::from_fn(|k| {
+                            rays.row(row + k as u32 / 4).ray(x + k as u32 % 4)
+                        });
                         let hits = c.intersect8(&r, 0xff, c.camera.t_min(), f32::INFINITY);
                         for (name, kernel) in &kernels {
                             let got = shade_packet_with(&c, &r, &hits, &s, *kernel);
                             for k in 0..N {
                                 let Some(hit) = &hits[k] else { continue };
-                                mesh_lanes += matches!(c.objects[hit.object as usize].shape, Shape::Mesh(_)) as usize;
+                                mesh_lanes +=
+                                    matches!(c.objects[hit.object as usize].shape, Shape::Mesh(_))
+                                        as usize;
                                 let (cw, nw) = shade_fast(&c, &r[k], hit, &s);
-                                assert_eq!((bits(got[k].0), bits(got[k].1)), (bits(cw), bits(nw)), "{name} {s:?} lane {k} at ({x}, {row})");
+                                assert_eq!(
+                                    (bits(got[k].0), bits(got[k].1)),
+                                    (bits(cw), bits(nw)),
+                                    "{name} {s:?} lane {k} at ({x}, {row})"
+                                );
                             }
                         }
                     }
                 }
             }
         }
-        assert!(mesh_lanes > 1000, "the meshes cover too little of the image: {mesh_lanes}");
+        assert!(
+            mesh_lanes > 1000,
+            "the meshes cover too little of the image: {mesh_lanes}"
+        );
     }
 }

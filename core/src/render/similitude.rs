@@ -40,7 +40,11 @@ impl SimilitudeTest {
     /// One line for the inspector and the command line.
     pub fn summary(&self) -> String {
         if let Some(l) = self.lambda {
-            let kind = if self.reflects { "similitude (with a reflection)" } else { "similitude" };
+            let kind = if self.reflects {
+                "similitude (with a reflection)"
+            } else {
+                "similitude"
+            };
             return format!("{kind}: (M⁻¹)ᵀ = λ·M with λ = {}", short(l));
         }
         let parts: Vec<String> = self
@@ -48,7 +52,11 @@ impl SimilitudeTest {
             .iter()
             .map(|b| match b {
                 Breaks::NonUniformScale { min, max } => {
-                    format!("non-uniform scale (axes stretched {} to {})", short(*min), short(*max))
+                    format!(
+                        "non-uniform scale (axes stretched {} to {})",
+                        short(*min),
+                        short(*max)
+                    )
                 }
                 Breaks::Shear { angle_degrees } => format!("shear (axes at {angle_degrees:.2}°)"),
             })
@@ -74,16 +82,37 @@ pub fn similitude_within(a: DMat3, tolerance: f64) -> SimilitudeTest {
     // AᵀA = c²·I exactly when A = c·Q: equal diagonal, zero off-diagonal, relative to c².
     let c2 = (len2[0] + len2[1] + len2[2]) / 3.0;
     let mut breaks = Vec::new();
-    let (min, max) = axis_scales.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+    let (min, max) = axis_scales
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| {
+            (lo.min(s), hi.max(s))
+        });
     if len2.iter().any(|&l| (l - c2).abs() > tolerance * c2) {
         breaks.push(Breaks::NonUniformScale { min, max });
     }
-    if pairs.iter().any(|&(i, j)| cols[i].dot(cols[j]).abs() > tolerance * c2) {
-        let worst = axis_angles.iter().copied().fold(90.0, |w: f64, a| if (a - 90.0).abs() > (w - 90.0).abs() { a } else { w });
-        breaks.push(Breaks::Shear { angle_degrees: worst });
+    if pairs
+        .iter()
+        .any(|&(i, j)| cols[i].dot(cols[j]).abs() > tolerance * c2)
+    {
+        let worst = axis_angles.iter().copied().fold(90.0, |w: f64, a| {
+            if (a - 90.0).abs() > (w - 90.0).abs() {
+                a
+            } else {
+                w
+            }
+        });
+        breaks.push(Breaks::Shear {
+            angle_degrees: worst,
+        });
     }
     let lambda = (breaks.is_empty() && c2 > 0.0).then(|| 1.0 / c2);
-    SimilitudeTest { axis_scales, axis_angles, reflects, lambda, breaks }
+    SimilitudeTest {
+        axis_scales,
+        axis_angles,
+        reflects,
+        lambda,
+        breaks,
+    }
 }
 
 fn angle_degrees(a: DVec3, b: DVec3) -> f64 {
@@ -92,7 +121,11 @@ fn angle_degrees(a: DVec3, b: DVec3) -> f64 {
 
 /// Four significant digits, in exponent form for huge and tiny values.
 fn short(v: f64) -> String {
-    if v != 0.0 && !(1e-3..1e5).contains(&v.abs()) { format!("{v:.3e}") } else { format!("{}", (v * 1e4).round() / 1e4) }
+    if v != 0.0 && !(1e-3..1e5).contains(&v.abs()) {
+        format!("{v:.3e}")
+    } else {
+        format!("{}", (v * 1e4).round() / 1e4)
+    }
 }
 
 #[cfg(test)]
@@ -102,7 +135,10 @@ mod tests {
 
     #[test]
     fn a_rotation_times_a_uniform_scale_is_a_similitude_with_lambda_one_over_c_squared() {
-        let a = DMat3::from_quat(DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7)) * 2.0;
+        let a = DMat3::from_quat(DQuat::from_axis_angle(
+            DVec3::new(1.0, 2.0, 3.0).normalize(),
+            0.7,
+        )) * 2.0;
         let t = similitude(a);
         assert!(t.is_similitude(), "{t:?}");
         let l = t.lambda.expect("lambda");
@@ -133,7 +169,11 @@ mod tests {
         let a = DMat3::from_cols(DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Z);
         let t = similitude(a);
         assert!(t.breaks.iter().any(|b| matches!(b, Breaks::Shear { angle_degrees } if (angle_degrees - 45.0).abs() < 1e-9)), "{t:?}");
-        assert!(t.breaks.iter().any(|b| matches!(b, Breaks::NonUniformScale { .. })));
+        assert!(
+            t.breaks
+                .iter()
+                .any(|b| matches!(b, Breaks::NonUniformScale { .. }))
+        );
     }
 
     #[test]
@@ -144,7 +184,10 @@ mod tests {
             (rot * 3.0, true),
             (DMat3::from_diagonal(DVec3::new(1.0, -1.0, 1.0)) * rot, true),
             (DMat3::from_diagonal(DVec3::new(2.0, 1.0, 1.0)) * rot, false),
-            (rot * DMat3::from_cols(DVec3::X, DVec3::new(0.5, 1.0, 0.0), DVec3::Z), false),
+            (
+                rot * DMat3::from_cols(DVec3::X, DVec3::new(0.5, 1.0, 0.0), DVec3::Z),
+                false,
+            ),
         ] {
             let gap = angle_degrees(a.inverse().transpose() * n, a * n);
             assert_eq!(similitude(a).is_similitude(), similar, "{a:?}");
@@ -159,6 +202,8 @@ mod tests {
         let a = DMat3::from_cols(DVec3::X, DVec3::new(c.cos(), c.sin(), 0.0), DVec3::Z);
         let t = similitude(a);
         assert_eq!(t.breaks.len(), 1, "{t:?}");
-        assert!(matches!(t.breaks[0], Breaks::Shear { angle_degrees } if (angle_degrees - 60.0).abs() < 1e-9));
+        assert!(
+            matches!(t.breaks[0], Breaks::Shear { angle_degrees } if (angle_degrees - 60.0).abs() < 1e-9)
+        );
     }
 }

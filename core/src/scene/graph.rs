@@ -20,14 +20,28 @@ pub enum NodeKind {
     Group,
     /// Ops as listed in the file: M = op1 · op2 · … · opn, so the first listed is applied last.
     Transform(Vec<TransformOp>),
-    Sphere { center: Vec3, radius: f32 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
     /// Points p with normal · p = offset.
-    Plane { normal: Vec3, offset: f32 },
-    Triangle { vertices: [Vec3; 3] },
-    TriangleMesh { obj_file: String, mesh: MeshSlot },
+    Plane {
+        normal: Vec3,
+        offset: f32,
+    },
+    Triangle {
+        vertices: [Vec3; 3],
+    },
+    TriangleMesh {
+        obj_file: String,
+        mesh: MeshSlot,
+    },
     /// An axis-aligned box in object space (an extension: it rotates and shears under a
     /// Transform).
-    Box { min: Vec3, max: Vec3 },
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
     /// Constructive solid geometry over exactly two operand solids (an extension).
     Csg(CsgOp),
 }
@@ -84,7 +98,10 @@ impl NodeKind {
     /// Whether the node holds other objects (a Group any number, a Transform one, a CSG
     /// node exactly two).
     pub fn is_container(&self) -> bool {
-        matches!(self, NodeKind::Group | NodeKind::Transform(_) | NodeKind::Csg(_))
+        matches!(
+            self,
+            NodeKind::Group | NodeKind::Transform(_) | NodeKind::Csg(_)
+        )
     }
 
     /// Whether the node is one of tracelab's extensions to the course grammar.
@@ -107,7 +124,12 @@ pub struct Node {
 
 impl Node {
     pub fn new(kind: NodeKind) -> Self {
-        Node { kind, material: None, children: Vec::new(), comments: Comments::default() }
+        Node {
+            kind,
+            material: None,
+            children: Vec::new(),
+            comments: Comments::default(),
+        }
     }
 }
 
@@ -126,7 +148,10 @@ impl Default for Graph {
 impl Graph {
     /// A graph holding one empty root Group.
     pub fn new() -> Self {
-        Graph { nodes: vec![Node::new(NodeKind::Group)], root: NodeId(0) }
+        Graph {
+            nodes: vec![Node::new(NodeKind::Group)],
+            root: NodeId(0),
+        }
     }
 
     pub fn root(&self) -> NodeId {
@@ -283,16 +308,25 @@ impl Graph {
                     kind: n.kind.clone(),
                     material: n.material,
                     comments: n.comments.clone(),
-                    children: n.children.iter().map(|c| NodeId(new_id[c.index()])).collect(),
+                    children: n
+                        .children
+                        .iter()
+                        .map(|c| NodeId(new_id[c.index()]))
+                        .collect(),
                 }
             })
             .collect();
-        Graph { nodes, root: NodeId(0) }
+        Graph {
+            nodes,
+            root: NodeId(0),
+        }
     }
 
     /// Iterates over all reachable nodes with their ids.
     pub fn iter(&self) -> impl Iterator<Item = (NodeId, &Node)> {
-        self.preorder().into_iter().map(move |id| (id, self.node(id)))
+        self.preorder()
+            .into_iter()
+            .map(move |id| (id, self.node(id)))
     }
 
     /// Counts of reachable objects and triangles, for status bars.
@@ -302,9 +336,10 @@ impl Graph {
             s.nodes += 1;
             match &n.kind {
                 NodeKind::Triangle { .. } => s.triangles += 1,
-                NodeKind::TriangleMesh { mesh: MeshSlot::Loaded(m), .. } => {
-                    s.triangles += m.triangle_count()
-                }
+                NodeKind::TriangleMesh {
+                    mesh: MeshSlot::Loaded(m),
+                    ..
+                } => s.triangles += m.triangle_count(),
                 _ => {}
             }
             if !n.kind.is_container() {

@@ -25,7 +25,11 @@ impl Mesh {
     /// Builds the BVH. Triangle indices must be in range (the loaders check).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
         let accel = TriangleBvh::build(&positions, &triangles);
-        Mesh { positions, triangles, accel }
+        Mesh {
+            positions,
+            triangles,
+            accel,
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -38,7 +42,12 @@ impl Mesh {
 
     pub fn triangle(&self, i: u32) -> [Vec3; 3] {
         let t = self.triangles.get(i as usize).copied().unwrap_or([0; 3]);
-        t.map(|v| self.positions.get(v as usize).copied().unwrap_or(Vec3::ZERO))
+        t.map(|v| {
+            self.positions
+                .get(v as usize)
+                .copied()
+                .unwrap_or(Vec3::ZERO)
+        })
     }
 
     pub fn face_normal(&self, i: u32) -> Vec3 {
@@ -116,7 +125,11 @@ pub fn check_closed(mesh: &Mesh) -> Result<(), NotClosed> {
         }
         if j - i != 2 {
             let (a, b) = edges[i];
-            return Err(NotClosed::OpenEdge { a: a + 1, b: b + 1, count: j - i });
+            return Err(NotClosed::OpenEdge {
+                a: a + 1,
+                b: b + 1,
+                count: j - i,
+            });
         }
         i = j;
     }
@@ -136,6 +149,9 @@ mod tests {
         let all = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
         assert_eq!(check_closed(&tetra(all.clone())), Ok(()));
         let open = check_closed(&tetra(all[..3].to_vec())).expect_err("open");
-        assert!(matches!(open, NotClosed::OpenEdge { count: 1, .. }), "{open}");
+        assert!(
+            matches!(open, NotClosed::OpenEdge { count: 1, .. }),
+            "{open}"
+        );
     }
 }

@@ -18,9 +18,19 @@ use glam::Vec3;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Camera {
-    Orthographic { center: Vec3, direction: Vec3, up: Vec3, size: f32 },
+    Orthographic {
+        center: Vec3,
+        direction: Vec3,
+        up: Vec3,
+        size: f32,
+    },
     /// `angle` is the full field of view in degrees.
-    Perspective { center: Vec3, direction: Vec3, up: Vec3, angle: f32 },
+    Perspective {
+        center: Vec3,
+        direction: Vec3,
+        up: Vec3,
+        angle: f32,
+    },
 }
 
 impl Default for Camera {
@@ -64,7 +74,11 @@ pub struct Light {
 
 impl Light {
     pub fn new(direction: Vec3, color: Vec3) -> Self {
-        Light { direction, color, comments: Comments::default() }
+        Light {
+            direction,
+            color,
+            comments: Comments::default(),
+        }
     }
 }
 
@@ -95,7 +109,12 @@ pub struct Material {
 
 impl Material {
     pub fn diffuse(diffuse: Vec3) -> Self {
-        Material { diffuse, keyword: MaterialKeyword::Material, extra: Vec::new(), comments: Comments::default() }
+        Material {
+            diffuse,
+            keyword: MaterialKeyword::Material,
+            extra: Vec::new(),
+            comments: Comments::default(),
+        }
     }
 }
 
@@ -184,10 +203,18 @@ impl Scene {
         let mut lines = Vec::new();
         let mut take = |c: &mut Comments| lines.extend(std::mem::take(c).lines().cloned());
         let sc = &mut s.comments;
-        for c in [&mut sc.camera, &mut sc.lights, &mut sc.background, &mut sc.materials] {
+        for c in [
+            &mut sc.camera,
+            &mut sc.lights,
+            &mut sc.background,
+            &mut sc.materials,
+        ] {
             take(c);
         }
-        take(&mut Comments { end: std::mem::take(&mut sc.end), ..Comments::default() });
+        take(&mut Comments {
+            end: std::mem::take(&mut sc.end),
+            ..Comments::default()
+        });
         for l in s.lights.iter_mut().flatten() {
             take(&mut l.comments);
         }

@@ -11,7 +11,10 @@ pub enum TransformOp {
     YRotate(f32),
     ZRotate(f32),
     /// Rotation about `axis` (normalised when composed) by `degrees`.
-    Rotate { axis: Vec3, degrees: f32 },
+    Rotate {
+        axis: Vec3,
+        degrees: f32,
+    },
     /// A 4×4 matrix, as written row by row in the file.
     Matrix(Mat4),
 }
@@ -53,7 +56,11 @@ impl TransformOp {
         // Very large and very small values in exponent form: 3.4028235e38, not 39 digits.
         let n = |x: f32| {
             let a = x.abs();
-            if a.is_finite() && (a >= 1e7 || (a != 0.0 && a < 1e-4)) { format!("{x:e}") } else { format!("{x}") }
+            if a.is_finite() && (a >= 1e7 || (a != 0.0 && a < 1e-4)) {
+                format!("{x:e}")
+            } else {
+                format!("{x}")
+            }
         };
         let v = |v: Vec3| format!("{}, {}, {}", n(v.x), n(v.y), n(v.z));
         match self {
@@ -63,7 +70,9 @@ impl TransformOp {
             TransformOp::XRotate(d) => format!("XRotate({}°)", n(*d)),
             TransformOp::YRotate(d) => format!("YRotate({}°)", n(*d)),
             TransformOp::ZRotate(d) => format!("ZRotate({}°)", n(*d)),
-            TransformOp::Rotate { axis, degrees } => format!("Rotate({}; {}°)", v(*axis), n(*degrees)),
+            TransformOp::Rotate { axis, degrees } => {
+                format!("Rotate({}; {}°)", v(*axis), n(*degrees))
+            }
             TransformOp::Matrix(_) => "Matrix(4×4)".to_string(),
         }
     }
@@ -83,14 +92,21 @@ mod tests {
 
     #[test]
     fn first_listed_op_is_applied_last() {
-        let m = compose(&[TransformOp::Translate(Vec3::X), TransformOp::UniformScale(2.0)]);
+        let m = compose(&[
+            TransformOp::Translate(Vec3::X),
+            TransformOp::UniformScale(2.0),
+        ]);
         // scale first (1,0,0) -> (2,0,0), then translate -> (3,0,0)
         assert!((m.transform_point3(Vec3::X) - Vec3::new(3.0, 0.0, 0.0)).length() < 1e-6);
     }
 
     #[test]
     fn rotate_axis_is_normalised() {
-        let a = TransformOp::Rotate { axis: Vec3::new(0.0, 0.0, 5.0), degrees: 90.0 }.matrix();
+        let a = TransformOp::Rotate {
+            axis: Vec3::new(0.0, 0.0, 5.0),
+            degrees: 90.0,
+        }
+        .matrix();
         let b = TransformOp::ZRotate(90.0).matrix();
         assert!(a.abs_diff_eq(b, 1e-6));
     }

@@ -104,12 +104,25 @@ pub const NASTY_NUMBERS: &[&str] = &[
 ];
 
 /// Numbers any reader must take.
-pub const PLAIN_NUMBERS: &[&str] = &["2", "0.5", "-3", "1e-3", "7", "0.25", "-0.75", "10", "1", "3"];
+pub const PLAIN_NUMBERS: &[&str] = &[
+    "2", "0.5", "-3", "1e-3", "7", "0.25", "-0.75", "10", "1", "3",
+];
 
 /// Bytes that must be rejected or escaped: NUL, invalid UTF-8, ESC, vertical tab, DEL, a
 /// bidi override.
-pub const NASTY_BYTES: &[&[u8]] =
-    &[b"\0", b"\xff", b"\x80", b"\xc3", b"\x1b[31m", b"\x0b", b"\x7f", b"\r", b"\t", "\u{202e}".as_bytes(), b"#"];
+pub const NASTY_BYTES: &[&[u8]] = &[
+    b"\0",
+    b"\xff",
+    b"\x80",
+    b"\xc3",
+    b"\x1b[31m",
+    b"\x0b",
+    b"\x7f",
+    b"\r",
+    b"\t",
+    "\u{202e}".as_bytes(),
+    b"#",
+];
 
 /// `seed` with 1 to 4 random edits: a token deleted, duplicated or swapped with another, a
 /// number replaced by a nasty one, a brace inserted or removed, a nasty byte inserted, or
@@ -120,7 +133,9 @@ pub fn mutate_text(seed: &[u8], extra_words: &[&str], rng: &mut Rng) -> Vec<u8> 
     let mut toks: Vec<(Vec<u8>, Vec<u8>)> = Vec::new();
     let mut rest = text.as_ref();
     while !rest.is_empty() {
-        let start = rest.find(|c: char| !c.is_ascii_whitespace()).unwrap_or(rest.len());
+        let start = rest
+            .find(|c: char| !c.is_ascii_whitespace())
+            .unwrap_or(rest.len());
         if start > 0 {
             match toks.last_mut() {
                 Some(t) => t.1.extend_from_slice(&rest.as_bytes()[..start]),
@@ -128,7 +143,9 @@ pub fn mutate_text(seed: &[u8], extra_words: &[&str], rng: &mut Rng) -> Vec<u8> 
             }
         }
         rest = &rest[start..];
-        let end = rest.find(|c: char| c.is_ascii_whitespace()).unwrap_or(rest.len());
+        let end = rest
+            .find(|c: char| c.is_ascii_whitespace())
+            .unwrap_or(rest.len());
         if end > 0 {
             toks.push((rest.as_bytes()[..end].to_vec(), Vec::new()));
         }
@@ -157,34 +174,59 @@ pub fn mutate_text(seed: &[u8], extra_words: &[&str], rng: &mut Rng) -> Vec<u8> 
             }
             3 | 4 => {
                 // Replace a number (or any token, when there is none nearby).
-                let numbers: Vec<usize> =
-                    (0..n).filter(|&k| toks[k].0.first().is_some_and(|c| c.is_ascii_digit() || *c == b'-')).collect();
-                let k = if numbers.is_empty() { i } else { numbers[rng.below(numbers.len())] };
+                let numbers: Vec<usize> = (0..n)
+                    .filter(|&k| {
+                        toks[k]
+                            .0
+                            .first()
+                            .is_some_and(|c| c.is_ascii_digit() || *c == b'-')
+                    })
+                    .collect();
+                let k = if numbers.is_empty() {
+                    i
+                } else {
+                    numbers[rng.below(numbers.len())]
+                };
                 if let Some(t) = toks.get_mut(k) {
                     // Half nasty, half plain, so that many mutated scenes are still accepted.
-                    let pool = if rng.below(2) == 0 { NASTY_NUMBERS } else { PLAIN_NUMBERS };
+                    let pool = if rng.below(2) == 0 {
+                        NASTY_NUMBERS
+                    } else {
+                        PLAIN_NUMBERS
+                    };
                     t.0 = pool[rng.below(pool.len())].as_bytes().to_vec();
                 }
             }
             5 => {
-                let brace = if rng.below(2) == 0 { b"{".to_vec() } else { b"}".to_vec() };
+                let brace = if rng.below(2) == 0 {
+                    b"{".to_vec()
+                } else {
+                    b"}".to_vec()
+                };
                 toks.insert(rng.below(n + 1), (brace, b" ".to_vec()));
             }
             6 if n > 0 => {
-                let braces: Vec<usize> = (0..n).filter(|&k| toks[k].0 == b"{" || toks[k].0 == b"}").collect();
+                let braces: Vec<usize> = (0..n)
+                    .filter(|&k| toks[k].0 == b"{" || toks[k].0 == b"}")
+                    .collect();
                 if !braces.is_empty() {
                     toks.remove(braces[rng.below(braces.len())]);
                 }
             }
             7 => inserts.push(NASTY_BYTES[rng.below(NASTY_BYTES.len())]),
             8 if !extra_words.is_empty() => {
-                let w = extra_words[rng.below(extra_words.len())].as_bytes().to_vec();
+                let w = extra_words[rng.below(extra_words.len())]
+                    .as_bytes()
+                    .to_vec();
                 toks.insert(rng.below(n + 1), (w, b" ".to_vec()));
             }
             _ => truncate = Some(rng.next()),
         }
     }
-    let mut out: Vec<u8> = toks.into_iter().flat_map(|(t, s)| t.into_iter().chain(s)).collect();
+    let mut out: Vec<u8> = toks
+        .into_iter()
+        .flat_map(|(t, s)| t.into_iter().chain(s))
+        .collect();
     for b in inserts {
         let at = rng.below(out.len() + 1);
         out.splice(at..at, b.iter().copied());
@@ -197,7 +239,10 @@ pub fn mutate_text(seed: &[u8], extra_words: &[&str], rng: &mut Rng) -> Vec<u8> 
 
 /// How many cases a fuzz test runs: `TRACELAB_FUZZ_CASES`, else `default`.
 pub fn fuzz_cases(default: u64) -> u64 {
-    std::env::var("TRACELAB_FUZZ_CASES").ok().and_then(|v| v.replace('_', "").parse().ok()).unwrap_or(default)
+    std::env::var("TRACELAB_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.replace('_', "").parse().ok())
+        .unwrap_or(default)
 }
 
 /// The input as a Rust byte-string literal, to paste into a regression test.

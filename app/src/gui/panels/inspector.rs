@@ -4,7 +4,9 @@
 
 use egui::DragValue;
 use glam::{Mat4, Vec3};
-use tracelab_core::{Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp};
+use tracelab_core::{
+    Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
+};
 
 use crate::document::edit::{Edit, Refusal};
 use crate::document::{Document, Selection};
@@ -42,7 +44,10 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
                     light(ui, doc, i, &mut edits);
                 }
                 if ui.button("Add light").clicked() {
-                    edits.push(Edit::AddLight(Light::new(Vec3::new(-0.5, -1.0, -0.5), Vec3::splat(0.5))));
+                    edits.push(Edit::AddLight(Light::new(
+                        Vec3::new(-0.5, -1.0, -0.5),
+                        Vec3::splat(0.5),
+                    )));
                 }
             }
             Some(Selection::Light(i)) => light(ui, doc, i, &mut edits),
@@ -62,7 +67,11 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
             }
             Some(Selection::Node(id)) => node(ui, doc, id, &mut edits, &mut asked),
         });
-    edits.into_iter().map(AppCommand::Edit).chain(asked).collect()
+    edits
+        .into_iter()
+        .map(AppCommand::Edit)
+        .chain(asked)
+        .collect()
 }
 
 /// Three drag values labelled for screen readers and tests (e.g. "Translate x").
@@ -91,13 +100,14 @@ fn name_widget(r: &egui::Response, name: String, value: f64) {
 }
 
 fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
-    let changed = ui.horizontal(|ui| {
-        ui.label(name);
-        let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
-        name_widget(&r, name.to_string(), f64::from(*v));
-        r.changed()
-    })
-    .inner;
+    let changed = ui
+        .horizontal(|ui| {
+            ui.label(name);
+            let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
+            name_widget(&r, name.to_string(), f64::from(*v));
+            r.changed()
+        })
+        .inner;
     refusal_note(ui, name);
     changed
 }
@@ -126,7 +136,11 @@ fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Place>) {
         .refusal
         .as_ref()
         .filter(|r: &&Refusal| r.place.is_some() && r.place == place)
-        .map(|r| Note { field: r.field.clone(), op: r.op, reason: r.reason.clone() });
+        .map(|r| Note {
+            field: r.field.clone(),
+            op: r.op,
+            reason: r.reason.clone(),
+        });
     ui.data_mut(|d| {
         d.insert_temp(note_id(), note);
         d.insert_temp(op_id(), None::<usize>);
@@ -138,39 +152,53 @@ fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Place>) {
 fn same_field(label: &str, field: &str) -> bool {
     let label = label.split(" (").next().unwrap_or(label);
     label == field
-        || label.strip_prefix(field).is_some_and(|rest| rest.starts_with(' '))
-        || matches!((label, field), ("colour", "color") | ("ambient light", "ambientLight"))
+        || label
+            .strip_prefix(field)
+            .is_some_and(|rest| rest.starts_with(' '))
+        || matches!(
+            (label, field),
+            ("colour", "color") | ("ambient light", "ambientLight")
+        )
         || (label.ends_with(": diffuse") && field == "diffuseColor")
 }
 
 fn refusal_note(ui: &mut egui::Ui, label: &str) {
-    let (note, op) = ui.data(|d| (d.get_temp::<Option<Note>>(note_id()).flatten(), d.get_temp::<Option<usize>>(op_id()).flatten()));
+    let (note, op) = ui.data(|d| {
+        (
+            d.get_temp::<Option<Note>>(note_id()).flatten(),
+            d.get_temp::<Option<usize>>(op_id()).flatten(),
+        )
+    });
     if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
         // Wrapped to the panel: a long reason must not widen it.
-        ui.add(egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color)).wrap());
+        ui.add(
+            egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color))
+                .wrap(),
+        );
     }
 }
 
 fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
-    let changed = ui.horizontal(|ui| {
-        ui.label(name);
-        let mut rgb = c.to_array();
-        let changed = ui.color_edit_button_rgb(&mut rgb).changed();
-        let mut changed2 = false;
-        for v in &mut rgb {
-            changed2 |= ui
-                .add(
-                    DragValue::new(v)
-                        .speed(0.005)
-                        .range(0.0..=4.0)
-                        .max_decimals(3),
-                )
-                .changed();
-        }
-        *c = Vec3::from_array(rgb);
-        changed || changed2
-    })
-    .inner;
+    let changed = ui
+        .horizontal(|ui| {
+            ui.label(name);
+            let mut rgb = c.to_array();
+            let changed = ui.color_edit_button_rgb(&mut rgb).changed();
+            let mut changed2 = false;
+            for v in &mut rgb {
+                changed2 |= ui
+                    .add(
+                        DragValue::new(v)
+                            .speed(0.005)
+                            .range(0.0..=4.0)
+                            .max_decimals(3),
+                    )
+                    .changed();
+            }
+            *c = Vec3::from_array(rgb);
+            changed || changed2
+        })
+        .inner;
     refusal_note(ui, name);
     changed
 }
@@ -296,7 +324,13 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
     });
 }
 
-fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, asked: &mut Vec<AppCommand>) {
+fn node(
+    ui: &mut egui::Ui,
+    doc: &Document,
+    id: NodeId,
+    edits: &mut Vec<Edit>,
+    asked: &mut Vec<AppCommand>,
+) {
     let g = &doc.scene.graph;
     let Some(n) = g.get(id) else { return };
     ui.heading(n.kind.name());
@@ -405,7 +439,9 @@ fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, as
                 ui.data_mut(|d| d.insert_temp(buf_id, path.clone()));
                 ui.colored_label(
                     ui.visuals().warn_fg_color,
-                    format!("not loaded yet (the scene uses {obj_file:?}): press Enter or Load / reload"),
+                    format!(
+                        "not loaded yet (the scene uses {obj_file:?}): press Enter or Load / reload"
+                    ),
                 );
             }
             match mesh {
@@ -427,7 +463,10 @@ fn node(ui: &mut egui::Ui, doc: &Document, id: NodeId, edits: &mut Vec<Edit>, as
                 || (path != *obj_file && ui.input(|i| i.key_pressed(egui::Key::Enter)))
             {
                 ui.data_mut(|d| d.remove::<String>(buf_id));
-                asked.push(AppCommand::LoadMesh { node: id, obj_file: path });
+                asked.push(AppCommand::LoadMesh {
+                    node: id,
+                    obj_file: path,
+                });
             }
         }
         NodeKind::Box { min, max } => {
@@ -490,7 +529,13 @@ fn op_names() -> [(&'static str, TransformOp); 8] {
 }
 
 /// `lengths[i]`: the drag speed of a length in the space op `i` acts in.
-fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengths: &[f64], edits: &mut Vec<Edit>) {
+fn transform_ops(
+    ui: &mut egui::Ui,
+    node: NodeId,
+    ops: &mut [TransformOp],
+    lengths: &[f64],
+    edits: &mut Vec<Edit>,
+) {
     ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
     // The ops together (or the chain above them) flatten space.
     refusal_note(ui, "ops");
@@ -502,8 +547,12 @@ fn transform_ops(ui: &mut egui::Ui, node: NodeId, ops: &mut [TransformOp], lengt
                 let len = lengths.get(index).copied().unwrap_or(0.02);
                 let changed = match op {
                     TransformOp::Translate(v) => vec3(ui, "Translate", v, len),
-                    TransformOp::Scale(v) => vec3(ui, "Scale", v, DragSpeeds::factor(v.abs().max_element())),
-                    TransformOp::UniformScale(s) => scalar(ui, "UniformScale", s, DragSpeeds::factor(*s)),
+                    TransformOp::Scale(v) => {
+                        vec3(ui, "Scale", v, DragSpeeds::factor(v.abs().max_element()))
+                    }
+                    TransformOp::UniformScale(s) => {
+                        scalar(ui, "UniformScale", s, DragSpeeds::factor(*s))
+                    }
                     TransformOp::XRotate(d) => scalar(ui, "XRotate (degrees)", d, 0.5),
                     TransformOp::YRotate(d) => scalar(ui, "YRotate (degrees)", d, 0.5),
                     TransformOp::ZRotate(d) => scalar(ui, "ZRotate (degrees)", d, 0.5),
@@ -619,9 +668,17 @@ mod tests {
 
     #[test]
     fn a_deep_breadcrumb_keeps_its_ends_and_counts_the_middle() {
-        assert_eq!(breadcrumb(&["Group", "Transform", "Sphere"]), "Group › Transform › Sphere");
-        let deep: Vec<&str> = std::iter::repeat_n("Group", 20_000).chain(["Sphere"]).collect();
+        assert_eq!(
+            breadcrumb(&["Group", "Transform", "Sphere"]),
+            "Group › Transform › Sphere"
+        );
+        let deep: Vec<&str> = std::iter::repeat_n("Group", 20_000)
+            .chain(["Sphere"])
+            .collect();
         let b = breadcrumb(&deep);
-        assert_eq!(b, "Group › Group › … 19995 more … › Group › Group › Group › Sphere");
+        assert_eq!(
+            b,
+            "Group › Group › … 19995 more … › Group › Group › Group › Sphere"
+        );
     }
 }

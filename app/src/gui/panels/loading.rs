@@ -9,8 +9,15 @@ pub fn ui(ui: &mut egui::Ui, loading: &Loading) -> bool {
     // move as the text changes, and a click aimed at it could land beside it.
     ui.horizontal(|ui| {
         ui.add(egui::Spinner::new());
-        let cancel = ui.button("Cancel").on_hover_text("Stop reading; the open scene stays").clicked();
-        ui.add(egui::ProgressBar::new(loading.fraction()).desired_width(160.0).animate(true));
+        let cancel = ui
+            .button("Cancel")
+            .on_hover_text("Stop reading; the open scene stays")
+            .clicked();
+        ui.add(
+            egui::ProgressBar::new(loading.fraction())
+                .desired_width(160.0)
+                .animate(true),
+        );
         ui.label(loading.describe());
         cancel
     })

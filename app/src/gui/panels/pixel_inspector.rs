@@ -25,9 +25,17 @@ pub struct Inspected {
 }
 
 /// Traces pixel (`x`, `row`) of image `frame` of a published render.
-pub fn trace(p: &Published, frame: usize, x: u32, row: u32) -> Option<(Inspected, RayStory, Arc<Scene>)> {
+pub fn trace(
+    p: &Published,
+    frame: usize,
+    x: u32,
+    row: u32,
+) -> Option<(Inspected, RayStory, Arc<Scene>)> {
     let mode = *p.job.modes.get(frame)?;
-    let settings = RenderSettings { normal_transform: mode, ..p.job.settings };
+    let settings = RenderSettings {
+        normal_transform: mode,
+        ..p.job.settings
+    };
     let at = Inspected {
         frame,
         x: x.min(settings.width.saturating_sub(1)),
@@ -47,9 +55,20 @@ pub fn follow(p: &Published, at: &Inspected) -> Option<(Inspected, RayStory, Arc
         return None;
     }
     let (w, h) = (p.job.settings.width, p.job.settings.height);
-    let scale = |v: u32, old: u32, new: u32| ((f64::from(v) + 0.5) * f64::from(new) / f64::from(old.max(1))) as u32;
-    let frame = if at.frame < p.job.modes.len() { at.frame } else { 0 };
-    trace(p, frame, scale(at.x, at.size.0, w), scale(at.row, at.size.1, h))
+    let scale = |v: u32, old: u32, new: u32| {
+        ((f64::from(v) + 0.5) * f64::from(new) / f64::from(old.max(1))) as u32
+    };
+    let frame = if at.frame < p.job.modes.len() {
+        at.frame
+    } else {
+        0
+    };
+    trace(
+        p,
+        frame,
+        scale(at.x, at.size.0, w),
+        scale(at.row, at.size.1, h),
+    )
 }
 
 fn v(v: Vec3) -> String {
@@ -67,7 +86,11 @@ pub fn ascii_math(s: &str) -> String {
 
 /// M, M⁻¹, (M⁻¹)ᵀ and the similitude line of one Transform, in a monospace block.
 pub fn matrices_ui(ui: &mut egui::Ui, t: &TransformReport) {
-    let text = transform_lines("", t).iter().map(|l| ascii_math(l)).collect::<Vec<_>>().join("\n");
+    let text = transform_lines("", t)
+        .iter()
+        .map(|l| ascii_math(l))
+        .collect::<Vec<_>>()
+        .join("\n");
     ui.label(egui::RichText::new(text).monospace().small());
 }
 
@@ -75,17 +98,36 @@ pub fn matrices_ui(ui: &mut egui::Ui, t: &TransformReport) {
 pub fn t_line(h: &HitReport, rule: ObjectRays) -> String {
     format!(
         "t: world {:.5}, object {:.5} (|M^-1 d| = {:.4}); rule {}: kept the {} t, {:.5}",
-        h.t.world, h.t.object, h.t.object_direction_length, rule.name(), h.t.used_is, h.t.used
+        h.t.world,
+        h.t.object,
+        h.t.object_direction_length,
+        rule.name(),
+        h.t.used_is,
+        h.t.used
     )
 }
 
 /// Draws the story. `scene` is the snapshot the story was traced in.
 pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
-    let RayStory { x, row, world_ray, hit, background, normal_transform } = story;
+    let RayStory {
+        x,
+        row,
+        world_ray,
+        hit,
+        background,
+        normal_transform,
+    } = story;
     ui.label(format!("Pixel ({x}, {row}), rows from the top"));
-    ui.label(format!("World ray: origin {} direction {}", v(world_ray.origin), v(world_ray.direction)));
+    ui.label(format!(
+        "World ray: origin {} direction {}",
+        v(world_ray.origin),
+        v(world_ray.direction)
+    ));
     let Some(story_hit) = hit else {
-        ui.label(format!("Missed every object: background {}", v(*background)));
+        ui.label(format!(
+            "Missed every object: background {}",
+            v(*background)
+        ));
         return;
     };
     let h = hit_report(scene, story_hit, *normal_transform);
@@ -98,13 +140,20 @@ pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
     for step in &h.path {
         ui.label(egui::RichText::new(&step.node.label).strong());
         ui.indent(("step", step.node.id), |ui| {
-            ui.label(format!("origin {}  direction {}", a(step.ray.origin), a(step.ray.direction)));
+            ui.label(format!(
+                "origin {}  direction {}",
+                a(step.ray.origin),
+                a(step.ray.direction)
+            ));
             if let Some(t) = &step.transform {
                 matrices_ui(ui, t);
             }
         });
     }
-    ui.label(format!("World from object: {}", ascii_math(&h.world_from_object.similitude.summary)));
+    ui.label(format!(
+        "World from object: {}",
+        ascii_math(&h.world_from_object.similitude.summary)
+    ));
     ui.separator();
     egui::Grid::new("hit").show(ui, |ui| {
         let mut row = |key: &str, value: String| {
@@ -117,12 +166,25 @@ pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
         row("normal (object)", a(h.normal.object));
         row("world normal by (M^-1)^T", a(h.normal.world_correct));
         row("world normal by M", a(h.normal.world_incorrect));
-        row("angle between them", format!("{:.3}°", h.normal.angle_degrees));
+        row(
+            "angle between them",
+            format!("{:.3}°", h.normal.angle_degrees),
+        );
         let rule = match normal_transform {
             NormalTransform::Correct => "(M^-1)^T",
             NormalTransform::Incorrect => "M",
         };
-        row("shading uses", format!("{rule}{}", if h.shading.back_facing { ", back-facing" } else { "" }));
+        row(
+            "shading uses",
+            format!(
+                "{rule}{}",
+                if h.shading.back_facing {
+                    ", back-facing"
+                } else {
+                    ""
+                }
+            ),
+        );
         row("diffuse k_d", a(h.shading.diffuse));
         row("ambient · k_d", a(h.shading.ambient));
         for (i, l) in h.shading.lights.iter().enumerate() {

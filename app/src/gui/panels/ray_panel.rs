@@ -25,7 +25,14 @@ fn color(role: Role) -> Color32 {
 }
 
 /// One diagram in `rect`; a drag on it turns `orbit`.
-fn draw(ui: &mut egui::Ui, id: &str, title: &str, d: &Diagram, orbit: &mut Orbit, size: egui::Vec2) {
+fn draw(
+    ui: &mut egui::Ui,
+    id: &str,
+    title: &str,
+    d: &Diagram,
+    orbit: &mut Orbit,
+    size: egui::Vec2,
+) {
     ui.vertical(|ui| {
         ui.strong(title);
         let (rect, response) = ui.allocate_exact_size(size, egui::Sense::drag());
@@ -67,7 +74,13 @@ fn draw(ui: &mut egui::Ui, id: &str, title: &str, d: &Diagram, orbit: &mut Orbit
                 }
             };
             if let Some(l) = &item.label {
-                painter.text(at + egui::vec2(4.0, -4.0), egui::Align2::LEFT_BOTTOM, l, egui::FontId::proportional(11.0), c);
+                painter.text(
+                    at + egui::vec2(4.0, -4.0),
+                    egui::Align2::LEFT_BOTTOM,
+                    l,
+                    egui::FontId::proportional(11.0),
+                    c,
+                );
             }
         }
         // Say where the origin is when it lies outside the view.
@@ -78,7 +91,10 @@ fn draw(ui: &mut egui::Ui, id: &str, title: &str, d: &Diagram, orbit: &mut Orbit
             painter.text(
                 rect.left_bottom() + egui::vec2(6.0, -6.0),
                 egui::Align2::LEFT_BOTTOM,
-                format!("ray origin ({:.2}, {:.2}, {:.2}) off view: scroll to zoom out", p.x, p.y, p.z),
+                format!(
+                    "ray origin ({:.2}, {:.2}, {:.2}) off view: scroll to zoom out",
+                    p.x, p.y, p.z
+                ),
                 egui::FontId::proportional(11.0),
                 color(Role::Eye),
             );
@@ -98,10 +114,20 @@ pub fn ui(ui: &mut egui::Ui, story: Option<(&RayStory, &Scene)>, orbits: &mut [O
         return;
     };
     let avail = ui.available_size();
-    let side = egui::vec2(((avail.x - 16.0) / 2.0).max(120.0), (avail.y - 24.0).max(120.0));
+    let side = egui::vec2(
+        ((avail.x - 16.0) / 2.0).max(120.0),
+        (avail.y - 24.0).max(120.0),
+    );
     let [w, o] = orbits;
     ui.horizontal(|ui| {
         draw(ui, "world", "World space", &world, w, side);
-        draw(ui, "object", "Object space (of the primitive hit)", &object, o, side);
+        draw(
+            ui,
+            "object",
+            "Object space (of the primitive hit)",
+            &object,
+            o,
+            side,
+        );
     });
 }

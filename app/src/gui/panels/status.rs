@@ -1,8 +1,8 @@
 //! The status bar: render progress, last full-frame time, scene statistics (objects,
 //! triangles, nodes), messages.
 
-use crate::render_worker::RenderWorker;
 use crate::document::Document;
+use crate::render_worker::RenderWorker;
 
 pub fn ui(
     ui: &mut egui::Ui,

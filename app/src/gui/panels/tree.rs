@@ -43,7 +43,9 @@ pub fn node_label(kind: &NodeKind, children: usize) -> String {
             MeshSlot::Loaded(m) => {
                 format!("TriangleMesh: {obj_file} ({} tris)", m.triangle_count())
             }
-            MeshSlot::Failed(_) | MeshSlot::Unresolved => format!("TriangleMesh: {obj_file} (not loaded)"),
+            MeshSlot::Failed(_) | MeshSlot::Unresolved => {
+                format!("TriangleMesh: {obj_file} (not loaded)")
+            }
         },
         NodeKind::Box { min, max } => format!("Box: ({}) to ({})", v(*min), v(*max)),
         NodeKind::Csg(op) => {
@@ -198,7 +200,8 @@ fn camera_label(scene: &Scene) -> String {
 
 fn swatch(ui: &mut egui::Ui, c: Vec3) {
     let (rect, _) = ui.allocate_exact_size(egui::vec2(10.0, 10.0), egui::Sense::hover());
-    ui.painter().rect_filled(rect, 2.0, crate::gui::widgets::color32(c));
+    ui.painter()
+        .rect_filled(rect, 2.0, crate::gui::widgets::color32(c));
 }
 
 /// The Group new objects go into: the selected Group, or the Group holding the selection.
@@ -263,8 +266,14 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
                     },
                 ),
                 ("Union of a box and a sphere", NodeKind::Csg(CsgOp::Union)),
-                ("Intersection of a box and a sphere", NodeKind::Csg(CsgOp::Intersection)),
-                ("Box minus a sphere (Subtraction)", NodeKind::Csg(CsgOp::Subtraction)),
+                (
+                    "Intersection of a box and a sphere",
+                    NodeKind::Csg(CsgOp::Intersection),
+                ),
+                (
+                    "Box minus a sphere (Subtraction)",
+                    NodeKind::Csg(CsgOp::Subtraction),
+                ),
                 ("Group", NodeKind::Group),
                 (
                     "Transform",

@@ -381,11 +381,19 @@ impl Viewport {
                         egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
                     ui.painter()
                         .image(tex.id(), left, luv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn { texture: tex_i, rect: left, uv: luv });
+                    self.drawn.push(Drawn {
+                        texture: tex_i,
+                        rect: left,
+                        uv: luv,
+                    });
                     if let Some(o) = other {
                         ui.painter().image(o.id(), right, ruv, egui::Color32::WHITE);
                         let texture = self.tex_index(1, view);
-                        self.drawn.push(Drawn { texture, rect: right, uv: ruv });
+                        self.drawn.push(Drawn {
+                            texture,
+                            rect: right,
+                            uv: ruv,
+                        });
                     }
                     ui.painter().vline(
                         xs,
@@ -399,11 +407,17 @@ impl Viewport {
                     }
                 } else {
                     ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn { texture: tex_i, rect, uv });
+                    self.drawn.push(Drawn {
+                        texture: tex_i,
+                        rect,
+                        uv,
+                    });
                 }
                 let view = OnScreen::new(&doc.scene.camera, w as u32, h as u32, rect);
                 let surface = |px: glam::Vec2| surface_point(worker, frame, px);
-                let used = self.tools.cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
+                let used = self
+                    .tools
+                    .cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
                 if s.overlays {
                     let painter = ui.painter().with_clip_rect(rect);
                     if let Some(o) = &self.outline {
@@ -451,9 +465,16 @@ impl Viewport {
     /// The outline of the selection, made again when the pixels or the selection change.
     fn upload_outline(&mut self, ctx: &egui::Context, p: &Published, doc: &Document) {
         // The image on screen stays the previous one until a pass is done; so does its outline.
-        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else { return };
+        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else {
+            return;
+        };
         // Once a pass, not once a tile: it runs over every pixel.
-        let key = Some((p.job.request, p.passes_done as u64, doc.selection, doc.generation));
+        let key = Some((
+            p.job.request,
+            p.passes_done as u64,
+            doc.selection,
+            doc.generation,
+        ));
         if self.outline_key == key {
             return;
         }
@@ -479,7 +500,11 @@ impl Viewport {
             .iter()
             .filter_map(|d| {
                 let image = self.images.get(d.texture)?.clone()?;
-                Some(Shown { rect: d.rect, uv: d.uv, image })
+                Some(Shown {
+                    rect: d.rect,
+                    uv: d.uv,
+                    image,
+                })
             })
             .collect()
     }

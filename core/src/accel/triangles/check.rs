@@ -39,7 +39,8 @@ impl TriangleBvh {
         positions: &[Vec3],
         triangles: &[[u32; 3]],
     ) -> Result<(), crate::accel::InvariantViolation> {
-        self.invariants(positions, triangles).map_err(crate::accel::InvariantViolation)
+        self.invariants(positions, triangles)
+            .map_err(crate::accel::InvariantViolation)
     }
 
     fn invariants(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), String> {

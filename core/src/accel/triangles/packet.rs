@@ -152,7 +152,9 @@ impl TriangleBvh {
                     leaves += 1;
                     leaf_rays += rays.count_ones();
                     // t_max still holds the callers' bounds: nothing is written until the end.
-                    if leaves == INCOHERENT_AFTER_LEAVES && leaf_rays < INCOHERENT_RAYS_PER_LEAF * leaves {
+                    if leaves == INCOHERENT_AFTER_LEAVES
+                        && leaf_rays < INCOHERENT_RAYS_PER_LEAF * leaves
+                    {
                         #[cfg(test)]
                         GAVE_UP.with(|g| g.set(g.get() + 1));
                         return self.singles8(o, d, active, t_min, t_max);

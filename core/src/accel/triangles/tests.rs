@@ -406,8 +406,16 @@ fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8
             // The sparse variant (incoherent packets one ray at a time) agrees too.
             let mut t_sparse = limits;
             let sparse = bvh.closest_hit8_with(&o, &d, active, t_min, &mut t_sparse, true);
-            assert_eq!(t_sparse.map(f32::to_bits), t_packet.map(f32::to_bits), "sparse, packet {p}");
-            assert_eq!(sparse.map(|h| h.map(|h| h.t)), got.map(|h| h.map(|h| h.t)), "sparse, packet {p}");
+            assert_eq!(
+                t_sparse.map(f32::to_bits),
+                t_packet.map(f32::to_bits),
+                "sparse, packet {p}"
+            );
+            assert_eq!(
+                sparse.map(|h| h.map(|h| h.t)),
+                got.map(|h| h.map(|h| h.t)),
+                "sparse, packet {p}"
+            );
             // The portable fallback (single rays) agrees too.
             let mut t_singles = limits;
             let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
@@ -503,7 +511,10 @@ fn packets_agree_with_single_rays_on_random_meshes() {
 fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
     // Every CPU the project runs on has AVX; one without fails here rather than passing
     // without checking anything.
-    assert!(has_avx(), "this test checks the AVX packet path: run it on a CPU with AVX");
+    assert!(
+        has_avx(),
+        "this test checks the AVX packet path: run it on a CPU with AVX"
+    );
     let (pos, tris) = random_mesh(200, 3);
     let bvh = build_checked(&pos, &tris);
     let eye = Vec3::new(0.0, 0.0, 6.0);
@@ -532,7 +543,10 @@ fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
 #[cfg(target_arch = "x86_64")]
 #[test]
 fn sparse_packets_of_rays_far_apart_go_one_by_one() {
-    assert!(has_avx(), "this test checks the AVX packet path: run it on a CPU with AVX");
+    assert!(
+        has_avx(),
+        "this test checks the AVX packet path: run it on a CPU with AVX"
+    );
     let (pos, tris) = random_mesh(20_000, 23);
     let bvh = build_checked(&pos, &tris);
     let eye = Vec3::new(0.3, 0.4, 6.0);
@@ -584,7 +598,11 @@ fn packets_on_empty_and_one_triangle_meshes() {
 #[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
 fn shared_meshes_agree_with_brute_force() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
-    assert!(dir.is_dir(), "{} is missing: this test needs ../shared beside the checkout", dir.display());
+    assert!(
+        dir.is_dir(),
+        "{} is missing: this test needs ../shared beside the checkout",
+        dir.display()
+    );
     // The dragon is left to the benchmark's checksums: brute force over 871k triangles
     // per ray is too slow for a unit test.
     for (name, rays) in [

@@ -72,7 +72,10 @@ fn split_lines(bytes: &[u8], size: usize) -> Vec<(usize, usize)> {
 }
 
 fn parse_chunk(text: &[u8]) -> Option<Chunk> {
-    let mut c = Chunk { excess: [i64::MIN; 3], ..Chunk::default() };
+    let mut c = Chunk {
+        excess: [i64::MIN; 3],
+        ..Chunk::default()
+    };
     let mut poly: Vec<u32> = Vec::new();
     for line in text.split(|&b| b == b'\n') {
         let mut words = line
@@ -125,7 +128,10 @@ fn parse_chunk(text: &[u8]) -> Option<Chunk> {
                 // tobj needs 2 (vt) or 3 (vn) numbers and ignores any more.
                 let n = if key == b"vt" { 2 } else { 3 };
                 for _ in 0..n {
-                    std::str::from_utf8(words.next()?).ok()?.parse::<f32>().ok()?;
+                    std::str::from_utf8(words.next()?)
+                        .ok()?
+                        .parse::<f32>()
+                        .ok()?;
                 }
                 if key == b"vt" {
                     c.texcoords += 1;
@@ -135,7 +141,10 @@ fn parse_chunk(text: &[u8]) -> Option<Chunk> {
             }
             b"usemtl" => {
                 // tobj takes the name after the first space and fails when it is blank.
-                let name = line.iter().position(|&b| b == b' ').map_or(&[][..], |i| &line[i + 1..]);
+                let name = line
+                    .iter()
+                    .position(|&b| b == b' ')
+                    .map_or(&[][..], |i| &line[i + 1..]);
                 if !name.iter().any(u8::is_ascii_graphic) {
                     return None;
                 }

@@ -29,12 +29,17 @@ impl FileKind {
             FileKind::Missing => "does not exist".to_string(),
             FileKind::Folder => "is a folder, not an OBJ file".to_string(),
             FileKind::Fifo => {
-                "is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only".to_string()
+                "is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only"
+                    .to_string()
             }
             FileKind::Device => "is a device, not an OBJ file".to_string(),
             FileKind::Socket => "is a socket, not an OBJ file".to_string(),
-            FileKind::DanglingLink => "is a symbolic link to a file that does not exist".to_string(),
-            FileKind::LinkLoop => "is a symbolic link loop (or a chain of links too long to follow)".to_string(),
+            FileKind::DanglingLink => {
+                "is a symbolic link to a file that does not exist".to_string()
+            }
+            FileKind::LinkLoop => {
+                "is a symbolic link loop (or a chain of links too long to follow)".to_string()
+            }
             FileKind::Unreadable(why) => format!("cannot be examined: {why}"),
         }
     }
@@ -88,7 +93,10 @@ fn kind_of(t: &std::fs::FileType) -> FileKind {
 /// Opens `path` only if it is a regular file, and checks the opened handle again, so a file
 /// swapped for a FIFO between the check and the open cannot block the reader.
 pub fn open_regular(path: &Path) -> Result<File, ObjError> {
-    let not_a_file = |k: FileKind| ObjError::NotAFile { path: path.to_path_buf(), what: k.describe() };
+    let not_a_file = |k: FileKind| ObjError::NotAFile {
+        path: path.to_path_buf(),
+        what: k.describe(),
+    };
     match file_kind(path) {
         FileKind::Regular => {}
         other => return Err(not_a_file(other)),
@@ -106,7 +114,10 @@ pub fn open_regular(path: &Path) -> Result<File, ObjError> {
 fn open_nonblocking(path: &Path) -> std::io::Result<File> {
     use std::os::unix::fs::OpenOptionsExt as _;
     const O_NONBLOCK: i32 = 0o4000;
-    std::fs::OpenOptions::new().read(true).custom_flags(O_NONBLOCK).open(path)
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(O_NONBLOCK)
+        .open(path)
 }
 
 #[cfg(not(target_os = "linux"))]
@@ -126,7 +137,9 @@ mod tests {
         std::fs::write(dir.join("f.obj"), "v 0 0 0\n").expect("write");
         std::os::unix::fs::symlink("loop", dir.join("loop")).expect("symlink");
         std::os::unix::fs::symlink("nothing", dir.join("dangling")).expect("symlink");
-        let fifo = std::process::Command::new("mkfifo").arg(dir.join("pipe")).status();
+        let fifo = std::process::Command::new("mkfifo")
+            .arg(dir.join("pipe"))
+            .status();
         assert!(fifo.is_ok_and(|s| s.success()), "mkfifo");
         assert_eq!(file_kind(&dir.join("f.obj")), FileKind::Regular);
         assert_eq!(file_kind(&dir), FileKind::Folder);
@@ -137,7 +150,12 @@ mod tests {
         assert_eq!(file_kind(Path::new("/dev/null")), FileKind::Device);
         // Refused without blocking (a blocking open of a FIFO would hang this test).
         let e = open_regular(&dir.join("pipe")).expect_err("a FIFO");
-        assert!(e.to_string().ends_with("is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only"), "{e}");
+        assert!(
+            e.to_string().ends_with(
+                "is a FIFO (named pipe), not an OBJ file; meshes are read from regular files only"
+            ),
+            "{e}"
+        );
         assert!(open_regular(&dir.join("f.obj")).is_ok());
         let _ = std::fs::remove_dir_all(&dir);
     }
