@@ -258,6 +258,45 @@ fn diff_reads_an_image_from_a_fifo() {
     );
 }
 
+#[cfg(unix)]
+#[test]
+fn diff_reads_no_more_than_an_image_of_the_asked_size_could_need() {
+    let d = student_dir("diff-cap");
+    // Larger than any 50×40 file (12 bytes a pixel and a MiB), but its header says
+    // 700×700: that is the verdict.
+    image::RgbImage::new(700, 700)
+        .save(d.join("big.bmp"))
+        .expect("save");
+    assert!(std::fs::metadata(d.join("big.bmp")).expect("meta").len() > 50 * 40 * 12 + (1 << 20));
+    let o = diff(&d, "big.bmp", "-input s.txt -size 50 40 -output x.png");
+    assert_eq!(o.status.code(), Some(3), "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("size 700×700, but the command line asks for 50×40"),
+        "{}",
+        stdout(&o)
+    );
+    // A pipe that never ends is read up to that cap, then refused.
+    let ok = Command::new("mkfifo")
+        .arg(d.join("endless.png"))
+        .status()
+        .is_ok_and(|s| s.success());
+    assert!(ok, "mkfifo");
+    let mut writer = Command::new("sh")
+        .args(["-c", "yes > endless.png"])
+        .current_dir(&d)
+        .spawn()
+        .expect("writer");
+    let o = diff(&d, "endless.png", "-input s.txt -size 50 40 -output x.png");
+    let _ = writer.kill();
+    let _ = writer.wait();
+    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stderr(&o).contains("endless.png: cannot read image: more than 1072576 bytes"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn diff_with_the_course_line_not_after_dashes_says_where_it_goes() {
     let d = student_dir("diff-dashes");

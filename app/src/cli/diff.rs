@@ -145,7 +145,8 @@ fn byte_cap(w: u32, h: u32) -> u64 {
 }
 
 /// Reads the file whole (so a pipe or FIFO works: nothing seeks on it) up to
-/// [`byte_cap`], then the size from the image's header alone: nothing is decoded yet.
+/// [`byte_cap`], then the size from the image's header alone: nothing is decoded yet. A
+/// longer file is refused unless its header gives another size (then only that is judged).
 fn read_student<'a>(
     what: &'static str,
     path: &'a Path,
@@ -171,14 +172,19 @@ fn read_student<'a>(
     file.take(cap + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| fail(&e))?;
+    let size = reader(&bytes, path).into_dimensions();
     if bytes.len() as u64 > cap {
-        return Err(fail(&format_args!(
-            "more than {cap} bytes, larger than any {w}×{h} image"
-        )));
+        // Too long for the size asked: a header of another size still gets its verdict.
+        match size {
+            Ok(other) if other != (w, h) => bytes = Vec::new(),
+            _ => {
+                return Err(fail(&format_args!(
+                    "more than {cap} bytes, larger than any {w}×{h} image"
+                )));
+            }
+        }
     }
-    let size = reader(&bytes, path)
-        .into_dimensions()
-        .map_err(|e| fail(&e))?;
+    let size = size.map_err(|e| fail(&e))?;
     Ok(Student {
         what,
         path,
