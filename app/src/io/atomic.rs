@@ -34,6 +34,31 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     }
 }
 
+/// Replaces `path` atomically without following a symlink there (the link itself is
+/// replaced, its target untouched): for names tracelab invents (`io::output`). A folder,
+/// device or FIFO is refused.
+pub(super) fn write_atomic_no_follow(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let existing = match std::fs::symlink_metadata(path) {
+        Ok(m) if m.is_file() => Some(m),
+        Ok(m) if m.file_type().is_symlink() => None,
+        Ok(_) => {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "not a regular file",
+            ));
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e),
+    };
+    replace(path, existing.as_ref(), bytes)
+}
+
+/// What `path` finally names once its symlinks are followed (itself when it is not a link
+/// or they cannot be followed): where `write_atomic` would write.
+pub(super) fn final_target(path: &Path) -> PathBuf {
+    resolve_symlinks(path).map_or_else(|_| path.to_path_buf(), |(t, _)| t)
+}
+
 /// Follows symlinks from `path` to what they finally name, and what is there (`None` for
 /// nothing yet: a new file, or a link to a file still to be made).
 fn resolve_symlinks(path: &Path) -> io::Result<(PathBuf, Option<Metadata>)> {
