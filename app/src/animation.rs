@@ -16,7 +16,8 @@ use tracelab_core::{
     TransformOp, View, check_scene,
 };
 
-use crate::io::{AtomicFile, write_atomic};
+use crate::io::output::check_output_folder;
+use crate::io::{AtomicFile, OutputError, OutputPlan, write_implicit};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
@@ -243,7 +244,7 @@ pub struct Destination {
     pub dir: PathBuf,
     pub stem: String,
     pub delay_ms: u16,
-    /// Files the command reads (the scene): never written, whatever the names.
+    /// Files the command reads (the scene, its meshes): never written, whatever the names.
     pub inputs: Vec<PathBuf>,
 }
 
@@ -316,8 +317,9 @@ pub fn export(
         AnimateError::Output(format!("{}: cannot write: {e}", p.display()))
     };
     let apng_path = files.last().cloned().unwrap_or_default();
-    let mut apng_file =
-        BufWriter::new(AtomicFile::create(&apng_path).map_err(|e| write_err(&apng_path, &e))?);
+    let mut apng_file = BufWriter::new(
+        AtomicFile::create_no_follow(&apng_path).map_err(|e| write_err(&apng_path, &e))?,
+    );
     let mut apng = apng_writer(&mut apng_file, (w, h), sweep.frames, to.delay_ms)
         .map_err(|e| write_err(&apng_path, &e))?;
     for (k, path) in (0..sweep.frames).zip(&files) {
@@ -332,7 +334,7 @@ pub fn export(
             ))
         })?;
         let png = encode_png(&rgb, w, h).map_err(|e| write_err(path, &e))?;
-        write_atomic(path, &png).map_err(|e| write_err(path, &e))?;
+        write_implicit(path, &png).map_err(|e| write_err(path, &e))?;
         apng.write_image_data(&rgb)
             .map_err(|e| write_err(&apng_path, &e))?;
         progress(k + 1);
@@ -346,61 +348,27 @@ pub fn export(
     Ok(files)
 }
 
-/// The files an export writes, in order, the animated PNG last; the folder made. An invented
-/// name never follows or replaces a symlink, anything but a regular file, or an input:
-/// refused before any frame is rendered.
-// TODO(issue 25): route these names through the one output policy (`io::output`, branch
-// h-output) once it is merged, instead of this local check.
+/// The files an export writes, in order, the animated PNG last, claimed through the output
+/// policy (`io::output`): the folder made and checked, and no invented name that is a
+/// symlink, a folder, a device or FIFO, or an input, refused before any frame is rendered.
 fn frame_files(to: &Destination, frames: u32) -> Result<Vec<PathBuf>, AnimateError> {
+    let refused = |e: OutputError| AnimateError::Output(e.to_string());
     std::fs::create_dir_all(&to.dir).map_err(|e| {
         AnimateError::Output(format!("{}: cannot create folder: {e}", to.dir.display()))
     })?;
+    check_output_folder(&to.dir).map_err(refused)?;
+    let mut plan = OutputPlan::new();
+    for input in &to.inputs {
+        plan.reads(input);
+    }
     let files: Vec<PathBuf> = (0..frames)
         .map(|k| to.dir.join(format!("{}_{k:04}.png", to.stem)))
         .chain([to.dir.join(format!("{}.apng.png", to.stem))])
         .collect();
-    let inputs: Vec<std::fs::Metadata> = to
-        .inputs
-        .iter()
-        .filter_map(|p| std::fs::metadata(p).ok())
-        .collect();
     for p in &files {
-        match std::fs::symlink_metadata(p) {
-            Ok(m) if m.file_type().is_symlink() => {
-                return Err(AnimateError::Output(format!(
-                    "{}: is a symbolic link; an animation's frame files never follow or replace \
-                     one (remove it, or choose another --stem or --out)",
-                    p.display()
-                )));
-            }
-            Ok(m) if !m.is_file() => {
-                return Err(AnimateError::Output(format!(
-                    "{}: exists and is not a regular file (choose another --stem or --out)",
-                    p.display()
-                )));
-            }
-            Ok(m) if inputs.iter().any(|i| same_file(i, &m)) => {
-                return Err(AnimateError::Output(format!(
-                    "{}: is an input of this command and is never written (choose another \
-                     --stem or --out)",
-                    p.display()
-                )));
-            }
-            _ => {}
-        }
+        plan.implicit_exact(p).map_err(refused)?;
     }
     Ok(files)
-}
-
-#[cfg(unix)]
-fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    (a.dev(), a.ino()) == (b.dev(), b.ino())
-}
-
-#[cfg(not(unix))]
-fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
-    false
 }
 
 /// An animated PNG's writer (looping forever, `delay_ms` a frame) with its header written;

@@ -20,6 +20,10 @@ pub enum Exit {
     /// itself was printed).
     #[error("the images do not match")]
     Differs,
+    /// `tracelab diff`: the verdicts were printed, but a heat map could not be written
+    /// (exit 4 when every image matched, 5 when one did not); `message` says why.
+    #[error("{message}")]
+    HeatMapNotWritten { matched: bool, message: String },
 }
 
 /// The size limit of `tracelab_core::render::check_image_size`, as a usage error.

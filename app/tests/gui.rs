@@ -340,6 +340,36 @@ fn export_all_three_writes_every_view() {
     );
 }
 
+#[cfg(unix)]
+#[test]
+fn export_never_writes_the_open_scene_or_through_a_planted_link() {
+    let d = temp_dir("export-policy");
+    // A scene whose name is an image's: exporting over it is refused.
+    let scene = d.join("scene.png");
+    let text = SPHERE_SCENE.replace("OP", "UniformScale 1");
+    std::fs::write(&scene, &text).expect("write");
+    let mut h = harness(Some(scene.clone()), (16, 12));
+    settle(&mut h);
+    let e = h.state_mut().export(&scene).expect_err("the open scene");
+    assert!(e.to_string().contains("names an input"), "{e}");
+    assert_eq!(std::fs::read_to_string(&scene).expect("read"), text);
+    // The names made for "All three" never follow a symlink, and nothing is written.
+    std::fs::write(d.join("victim.txt"), "keep").expect("write");
+    std::os::unix::fs::symlink("victim.txt", d.join("shot_normals.png")).expect("plant");
+    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::All;
+    settle(&mut h);
+    let e = h
+        .state_mut()
+        .export(&d.join("shot.png"))
+        .expect_err("a planted link");
+    assert!(e.to_string().contains("symbolic link"), "{e}");
+    assert_eq!(
+        std::fs::read_to_string(d.join("victim.txt")).expect("read"),
+        "keep"
+    );
+    assert!(!d.join("shot_color.png").exists());
+}
+
 #[test]
 fn a_file_changed_on_disk_is_reloaded() {
     let path = temp_dir("reload").join("sphere.txt");

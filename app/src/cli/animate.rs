@@ -9,7 +9,7 @@ use tracelab_core::{NodeId, RenderSettings};
 use super::render::{NormalMode, ObjectRaysMode};
 use crate::animation::{AnimateError, Destination, Sweep, check_stem, export, frame_size};
 use crate::exit::{check_size, usage};
-use crate::io::load_scene;
+use crate::io::load_scene_and_meshes;
 
 #[derive(clap::Args, Debug)]
 pub struct AnimateArgs {
@@ -68,7 +68,7 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     };
     // The compare view is twice as wide: checked before the scene is read.
     frame_size(&settings, a.compare).map_err(usage)?;
-    let scene = load_scene(Some(&a.scene))?;
+    let (scene, meshes) = load_scene_and_meshes(Some(&a.scene))?;
     let sweep = Sweep {
         node: NodeId(a.node),
         op: a.op,
@@ -81,7 +81,7 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
         dir: a.out.clone(),
         stem: a.stem.clone(),
         delay_ms: a.delay_ms,
-        inputs: vec![a.scene.clone()],
+        inputs: std::iter::once(a.scene.clone()).chain(meshes).collect(),
     };
     let never = AtomicBool::new(false);
     match export(&scene, &sweep, &settings, a.compare, &to, &never, |_| {}) {

@@ -16,7 +16,7 @@ use tracelab_core::{CompiledScene, Frame, RenderSettings, Scene, View};
 use super::course::parse_course_args;
 use super::render::{RenderJob, render_with_progress};
 use crate::exit::{Exit, check_size, usage};
-use crate::io::{load_scene, write_atomic, write_stdout};
+use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout};
 use crate::story::{one_line, pixel_report};
 
 /// `tracelab diff --help`.
@@ -26,13 +26,16 @@ pub const LONG_ABOUT: &str = "Compare your ray tracer's image with tracelab's re
     then a pixel matches when no channel differs by more than --tolerance (of 255), and the image \
     matches when at least --min-match percent of its pixels do (the course's graders allow a few \
     pixels on silhouettes). A heat map is written beside IMAGE (IMAGE.diff.png): matching pixels as \
-    dim grey, the others from red (just over) to yellow (far off). For the worst pixels the one-line \
+    dim grey, the others from red (just over) to yellow (far off). The heat map never replaces a file \
+    named on the command line, a symbolic link or anything but a regular file: then it is written as \
+    IMAGE.diff-2.png (or -3, ...), and the verdict says so. For the worst pixels the one-line \
     story of the reference ray is printed: what it hit, at which t, with which normal. When the line \
     names -normals or -depth files, those files (your program's outputs) are compared with the \
     reference's too.\n\n\
     Pixel coordinates are x from the left, row from the top (as in tracelab inspect).\n\
-    Exit status: 0 when every image matches, 3 when one does not, 1 for a file that cannot be read, \
-    2 for a usage error.";
+    Exit status: 0 when every image matches, 3 when one does not, 4 when every image matches but a \
+    heat map could not be written, 5 when one does not match and a heat map could not be written \
+    (the verdicts are printed either way), 1 for a file that cannot be read, 2 for a usage error.";
 
 #[derive(clap::Args, Debug)]
 pub struct DiffArgs {
@@ -124,17 +127,103 @@ pub fn heat_map(mine: &RgbImage, reference: &RgbImage, tolerance: u8) -> RgbImag
     })
 }
 
-fn read_image(path: &Path) -> anyhow::Result<RgbImage> {
-    let img = image::ImageReader::open(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read image: {e}", path.display()))?
-        .with_guessed_format()
-        .map_err(|e| anyhow::anyhow!("{}: cannot read image: {e}", path.display()))?
-        .decode()
-        .map_err(|e| anyhow::anyhow!("{}: cannot read image: {e}", path.display()))?;
-    Ok(img.to_rgb8())
+/// A student's image as read, before the render: its bytes and the size its header claims.
+struct Student<'a> {
+    what: &'static str,
+    path: &'a Path,
+    view: View,
+    depth: (f32, f32),
+    bytes: Vec<u8>,
+    size: (u32, u32),
 }
 
-/// `mine.png` → `mine.diff.png`, beside it.
+/// The most bytes read as an image of `w`×`h`: 12 a pixel (an ASCII PPM writes up to
+/// "255 255 255 ") and a MiB of headers. A larger file is no such image, and a pipe or
+/// device could go on for ever.
+fn byte_cap(w: u32, h: u32) -> u64 {
+    u64::from(w) * u64::from(h) * 12 + (1 << 20)
+}
+
+/// Reads the file whole (so a pipe or FIFO works: nothing seeks on it) up to
+/// [`byte_cap`], then the size from the image's header alone: nothing is decoded yet. A
+/// longer file is refused unless its header gives another size (then only that is judged).
+fn read_student<'a>(
+    what: &'static str,
+    path: &'a Path,
+    view: View,
+    depth: (f32, f32),
+    (w, h): (u32, u32),
+) -> anyhow::Result<Student<'a>> {
+    use std::io::Read;
+    let fail =
+        |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: cannot read image: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
+    let meta = file.metadata().map_err(|e| fail(&e))?;
+    if meta.is_dir() {
+        return Err(fail(&"it is a folder"));
+    }
+    let cap = byte_cap(w, h);
+    let mut bytes = Vec::new();
+    if meta.is_file() {
+        bytes
+            .try_reserve_exact(meta.len().min(cap + 1) as usize)
+            .map_err(|e| fail(&e))?;
+    }
+    file.take(cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| fail(&e))?;
+    let size = reader(&bytes, path).into_dimensions();
+    if bytes.len() as u64 > cap {
+        // Too long for the size asked: a header of another size still gets its verdict.
+        match size {
+            Ok(other) if other != (w, h) => bytes = Vec::new(),
+            _ => {
+                return Err(fail(&format_args!(
+                    "more than {cap} bytes, larger than any {w}×{h} image"
+                )));
+            }
+        }
+    }
+    let size = size.map_err(|e| fail(&e))?;
+    Ok(Student {
+        what,
+        path,
+        view,
+        depth,
+        bytes,
+        size,
+    })
+}
+
+/// A reader for the bytes: the format from the content where it says (PNG, BMP, PPM), else
+/// from the file name's extension (TGA has no signature).
+fn reader<'b>(bytes: &'b [u8], path: &Path) -> image::ImageReader<Cursor<&'b [u8]>> {
+    let mut r = image::ImageReader::new(Cursor::new(bytes));
+    if let Some(f) = image::guess_format(bytes)
+        .ok()
+        .or_else(|| image::ImageFormat::from_path(path).ok())
+    {
+        r.set_format(f);
+    }
+    r
+}
+
+/// Decodes an image whose header said `w`×`h`, with the decoder held to that size and to
+/// the memory such an image needs (16-bit RGBA at most), whatever the data says.
+fn decode(s: &Student, (w, h): (u32, u32)) -> anyhow::Result<RgbImage> {
+    let mut r = reader(&s.bytes, s.path);
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    limits.max_alloc = Some(u64::from(w) * u64::from(h) * 8 + (1 << 20));
+    r.limits(limits);
+    let img = r
+        .decode()
+        .map_err(|e| anyhow::anyhow!("{}: cannot read image: {e}", s.path.display()))?;
+    Ok(img.into_rgb8())
+}
+
+/// `mine.png` → `mine.diff.png`, beside it (the output policy may choose `mine.diff-2.png`).
 fn heat_map_path(image: &Path) -> PathBuf {
     let stem = image
         .file_stem()
@@ -143,12 +232,18 @@ fn heat_map_path(image: &Path) -> PathBuf {
     image.with_file_name(format!("{stem}.diff.png"))
 }
 
-fn write_png(img: &RgbImage, path: &Path) -> anyhow::Result<()> {
+/// Chooses the heat map's name and writes it; an error says why it was not written.
+fn write_heat_map(img: &RgbImage, image: &Path, plan: &mut OutputPlan) -> Result<Implicit, String> {
+    let chosen = plan
+        .implicit(&heat_map_path(image))
+        .map_err(|e| format!("heat map {e}"))?;
+    let path = &chosen.path;
     let mut bytes = Vec::new();
     img.write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| anyhow::anyhow!("{}: cannot encode heat map: {e}", path.display()))?;
-    write_atomic(path, &bytes)
-        .map_err(|e| anyhow::anyhow!("{}: cannot write heat map: {e}", path.display()))
+        .map_err(|e| format!("{}: cannot encode heat map: {e}", path.display()))?;
+    write_implicit(path, &bytes)
+        .map_err(|e| format!("{}: cannot write heat map: {e}", path.display()))?;
+    Ok(chosen)
 }
 
 struct Reference<'a> {
@@ -159,42 +254,59 @@ struct Reference<'a> {
 }
 
 /// Compares one of the student's images with one view of the reference, printing the
-/// verdict and the worst pixels. Returns whether it matches.
+/// verdict and the worst pixels. Returns whether it matches; a heat map that could not be
+/// written is said in the verdict and its reason pushed on `failed`.
 fn check(
     a: &DiffArgs,
     r: &Reference,
-    what: &str,
-    mine_path: &Path,
-    view: View,
-    depth: (f32, f32),
+    s: &Student,
+    plan: &mut OutputPlan,
     out: &mut String,
+    failed: &mut Vec<String>,
 ) -> anyhow::Result<bool> {
-    let mine = read_image(mine_path)?;
     let (w, h) = (r.frame.width, r.frame.height);
-    if mine.dimensions() != (w, h) {
+    if s.size != (w, h) {
         out.push_str(&format!(
-            "{what} {}: size {}×{}, but the command line asks for {w}×{h}: does not match\n",
-            mine_path.display(),
-            mine.width(),
-            mine.height()
+            "{} {}: size {}×{}, but the command line asks for {w}×{h}: does not match\n",
+            s.what,
+            s.path.display(),
+            s.size.0,
+            s.size.1
         ));
         return Ok(false);
     }
-    let reference = RgbImage::from_raw(w, h, r.frame.rgb8(view, depth))
+    let mine = decode(s, (w, h))?;
+    let reference = RgbImage::from_raw(w, h, r.frame.rgb8(s.view, s.depth))
         .ok_or_else(|| anyhow::anyhow!("reference image has the wrong size"))?;
     let c = compare(&mine, &reference, a.tolerance, a.worst);
     let ok = c.percent() >= a.min_match;
-    let map = heat_map_path(mine_path);
-    write_png(&heat_map(&mine, &reference, a.tolerance), &map)?;
+    let map = match write_heat_map(&heat_map(&mine, &reference, a.tolerance), s.path, plan) {
+        Ok(Implicit {
+            path,
+            instead_of: None,
+        }) => format!("heat map {}", path.display()),
+        Ok(Implicit {
+            path,
+            instead_of: Some((wanted, why)),
+        }) => format!(
+            "heat map {} (not {}: {why})",
+            path.display(),
+            wanted.display()
+        ),
+        Err(e) => {
+            failed.push(e);
+            "heat map not written".to_string()
+        }
+    };
     out.push_str(&format!(
-        "{what} {}: {:.2}% of {} pixels within {}/255 (largest difference {}): {}; heat map {}\n",
-        mine_path.display(),
+        "{} {}: {:.2}% of {} pixels within {}/255 (largest difference {}): {}; {map}\n",
+        s.what,
+        s.path.display(),
         c.percent(),
         c.total,
         a.tolerance,
         c.max_difference,
         if ok { "matches" } else { "does not match" },
-        map.display()
     ));
     for &(d, x, row) in &c.worst {
         let story = inspect_pixel(r.scene, r.compiled, &r.settings, x, row);
@@ -218,7 +330,33 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     }
     let job: RenderJob = parse_course_args(&a.course)?;
     check_size(job.width, job.height)?;
-    let scene = load_scene(job.scene.as_deref())?;
+    let size = (job.width, job.height);
+    // Heat maps are invented names: never a file this command reads or the line names.
+    let mut plan = OutputPlan::new();
+    plan.reads(&a.image);
+    if let Some(s) = &job.scene {
+        plan.reads(s);
+    }
+    if let Some(o) = &job.output {
+        plan.names(o);
+    }
+    let mut wanted = vec![("colour", a.image.as_path(), View::Color, (0.0, 1.0))];
+    if let Some(n) = &job.normals {
+        wanted.push(("normals", n, View::Normals, (0.0, 1.0)));
+    }
+    if let Some((min, max, d)) = &job.depth {
+        wanted.push(("depth", d, View::Depth, (*min, *max)));
+    }
+    // Every image is read and its header checked before the (possibly long) render.
+    let mut students = Vec::new();
+    for (what, path, view, depth) in wanted {
+        plan.reads(path);
+        students.push(read_student(what, path, view, depth, size)?);
+    }
+    let (scene, meshes) = load_scene_and_meshes(job.scene.as_deref())?;
+    for m in &meshes {
+        plan.reads(m);
+    }
     let compiled = CompiledScene::new(&scene);
     let settings = RenderSettings {
         shade_back: job.shade_back,
@@ -234,14 +372,19 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         frame: &frame,
     };
     let mut out = String::new();
-    let mut all = check(a, &r, "colour", &a.image, View::Color, (0.0, 1.0), &mut out)?;
-    if let Some(n) = &job.normals {
-        all &= check(a, &r, "normals", n, View::Normals, (0.0, 1.0), &mut out)?;
-    }
-    if let Some((min, max, d)) = &job.depth {
-        all &= check(a, &r, "depth", d, View::Depth, (*min, *max), &mut out)?;
+    let mut failed = Vec::new();
+    let mut all = true;
+    for s in &students {
+        all &= check(a, &r, s, &mut plan, &mut out, &mut failed)?;
     }
     write_stdout(out.as_bytes())?;
+    if !failed.is_empty() {
+        return Err(Exit::HeatMapNotWritten {
+            matched: all,
+            message: failed.join("\n"),
+        }
+        .into());
+    }
     if all {
         Ok(())
     } else {

@@ -2,13 +2,33 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::io::{load_scene_text, write_stdout};
+use tracelab_core::NodeKind;
+
+use crate::io::{OutputError, OutputPlan, load_scene_text, write_stdout};
 
 /// Warnings (comments that cannot be kept) go to stderr before anything is written. OBJ
 /// files are not opened: the text is all `fmt` rewrites.
+///
+/// `-o` never names the scene itself (the comments `fmt` cannot keep would be lost with no
+/// copy left) or one of its OBJ files: see `crate::io::output`.
 pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()> {
+    let mut plan = OutputPlan::new();
+    if let Some(out) = output {
+        plan.reads(scene).writes(out);
+        plan.check().map_err(OutputError::into_cli)?;
+    }
     let mut s = load_scene_text(scene)?;
     if let Some(out) = output {
+        // The meshes are not read, but the scene names them: looked for beside it, then in
+        // the current folder (as `resolve_obj_path` does).
+        let beside = scene.parent().unwrap_or(Path::new(""));
+        for (_, node) in s.graph.iter() {
+            if let NodeKind::TriangleMesh { obj_file, .. } = &node.kind {
+                plan.names(&beside.join(obj_file))
+                    .names(Path::new(obj_file));
+            }
+        }
+        plan.check().map_err(OutputError::into_cli)?;
         let dir = |p: &Path| {
             p.parent()
                 .map_or_else(|| PathBuf::from("."), Path::to_path_buf)

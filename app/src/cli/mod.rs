@@ -2,7 +2,8 @@
 //! This module dispatches; each command lives in its own file (`render`, `fmt`, the course's
 //! flags in `course`), the benchmarks in `crate::bench`, the editor in `crate::gui`.
 //!
-//! Exit codes: 0 success, 1 scene or I/O error, 2 usage error (see `crate::exit`).
+//! Exit codes: 0 success, 1 scene or I/O error, 2 usage error; `diff` adds 3, 4 and 5 (see
+//! `crate::exit`).
 
 mod animate;
 mod course;
@@ -90,6 +91,10 @@ fn report(e: &anyhow::Error) -> ExitCode {
         Some(Exit::UsagePrinted) => ExitCode::from(2),
         Some(Exit::OutputClosed) => ExitCode::SUCCESS,
         Some(Exit::Differs) => ExitCode::from(3),
+        Some(Exit::HeatMapNotWritten { matched, message }) => {
+            print_err(&format!("{message}\n"));
+            ExitCode::from(if *matched { 4 } else { 5 })
+        }
         None => {
             let m = e.to_string();
             print_err(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }));
@@ -112,6 +117,14 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
         .take_while(|a| *a != "--")
         .any(|a| a == "-input")
     {
+        if args.get(1).is_some_and(|a| a == "diff") {
+            return Err(Exit::Usage(
+                "diff: the course's command line goes after `--`: \
+                 tracelab diff IMAGE -- -input SCENE -size W H ..."
+                    .into(),
+            )
+            .into());
+        }
         let job = parse_course_args(args.get(1..).unwrap_or_default())?;
         return run_render(&job);
     }

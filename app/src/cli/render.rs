@@ -14,7 +14,7 @@ use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, 
 
 use super::values::parse_f32;
 use crate::exit::{check_size, usage};
-use crate::io::load_scene;
+use crate::io::{OutputError, OutputPlan, load_scene_and_meshes};
 
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
@@ -128,6 +128,9 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
 }
 
 fn check_extension(path: &Path) -> anyhow::Result<()> {
+    if crate::io::output::names_a_folder(path) {
+        return Err(OutputError::NamesAFolder(path.to_path_buf()).into_cli());
+    }
     match crate::io::image_format(path) {
         Some(_) => Ok(()),
         None => Err(usage(format!(
@@ -138,17 +141,35 @@ fn check_extension(path: &Path) -> anyhow::Result<()> {
 }
 
 pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
-    for p in [&job.output, &job.normals]
-        .into_iter()
-        .flatten()
-        .chain(job.depth.as_ref().map(|d| &d.2))
-    {
+    let outputs = || {
+        [&job.output, &job.normals]
+            .into_iter()
+            .flatten()
+            .chain(job.depth.as_ref().map(|d| &d.2))
+    };
+    for p in outputs() {
         check_extension(p)?;
     }
     // Before loading, and long before allocating the frame.
     check_size(job.width, job.height)?;
     check_memory(job.width, job.height)?;
-    let scene = load_scene(job.scene.as_deref())?;
+    // Outputs against the scene, each other and their folders before anything is read, then
+    // against the meshes the scene turned out to read, before the render.
+    let mut plan = OutputPlan::new();
+    if let Some(s) = &job.scene {
+        plan.reads(s);
+    }
+    for p in outputs() {
+        plan.writes(p);
+    }
+    plan.check().map_err(OutputError::into_cli)?;
+    let (scene, meshes) = load_scene_and_meshes(job.scene.as_deref())?;
+    if !meshes.is_empty() {
+        for m in &meshes {
+            plan.reads(m);
+        }
+        plan.check().map_err(OutputError::into_cli)?;
+    }
     let compiled = CompiledScene::try_new(&scene).map_err(|e| {
         anyhow::anyhow!("not enough memory to prepare the scene for rendering: {e}")
     })?;

@@ -596,16 +596,16 @@ impl TracelabApp {
             .unwrap_or_default();
         let ext = ext.unwrap_or_default();
         let depth = self.view.depth;
+        // The output policy (crate::io::output): never the open scene file; the names made
+        // for several images never a symlink, folder or device; checked before any is written.
+        let mut plan = crate::io::OutputPlan::new();
+        if let Some(scene) = &self.doc.path {
+            plan.reads(scene);
+        }
         self.worker.with_published(|p| {
             let p = p.ok_or_else(|| anyhow::anyhow!("nothing rendered yet"))?;
-            let mut written = Vec::new();
+            let mut targets = Vec::new();
             for (f, view, _) in &cells {
-                let frame = p
-                    .frames
-                    .get(*f)
-                    .ok_or_else(|| anyhow::anyhow!("no such frame"))?
-                    .lock()
-                    .clone();
                 let target = if many {
                     let v = match view {
                         tracelab_core::View::Color => "color",
@@ -621,7 +621,23 @@ impl TracelabApp {
                 } else {
                     path.to_path_buf()
                 };
-                crate::io::write_image(&frame, *view, depth, &target)?;
+                if many {
+                    plan.implicit_exact(&target)?;
+                } else {
+                    plan.writes(&target);
+                }
+                targets.push((*f, *view, target));
+            }
+            plan.check()?;
+            let mut written = Vec::new();
+            for (f, view, target) in targets {
+                let frame = p
+                    .frames
+                    .get(f)
+                    .ok_or_else(|| anyhow::anyhow!("no such frame"))?
+                    .lock()
+                    .clone();
+                crate::io::write_image(&frame, view, depth, &target)?;
                 written.push(target);
             }
             Ok(written)

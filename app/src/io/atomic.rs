@@ -77,6 +77,27 @@ impl AtomicFile {
         Ok(AtomicFile { out })
     }
 
+    /// As [`AtomicFile::create`] for a name tracelab invents (`io::output`): a symlink there
+    /// is not followed but replaced at commit, its target untouched; a folder, device or
+    /// FIFO is refused.
+    pub fn create_no_follow(path: &Path) -> io::Result<AtomicFile> {
+        let existing = match std::fs::symlink_metadata(path) {
+            Ok(m) if m.is_file() => Some(m),
+            Ok(m) if m.file_type().is_symlink() => None,
+            Ok(_) => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    "not a regular file",
+                ));
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(e),
+        };
+        Ok(AtomicFile {
+            out: temporary(path.to_path_buf(), existing)?,
+        })
+    }
+
     /// Flushes, syncs and puts the file in place (or, for a device or FIFO, flushes it).
     pub fn commit(self) -> io::Result<()> {
         match self.out {
@@ -146,6 +167,21 @@ impl Write for AtomicFile {
             Out::Named { tmp, .. } => tmp.flush(),
         }
     }
+}
+
+/// Replaces `path` atomically without following a symlink there (the link itself is
+/// replaced, its target untouched): for names tracelab invents (`io::output`). A folder,
+/// device or FIFO is refused.
+pub(super) fn write_atomic_no_follow(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = AtomicFile::create_no_follow(path)?;
+    file.write_all(bytes)?;
+    file.commit()
+}
+
+/// What `path` finally names once its symlinks are followed (itself when it is not a link
+/// or they cannot be followed): where `write_atomic` would write.
+pub(super) fn final_target(path: &Path) -> PathBuf {
+    resolve_symlinks(path).map_or_else(|_| path.to_path_buf(), |(t, _)| t)
 }
 
 /// Follows symlinks from `path` to what they finally name, and what is there (`None` for

@@ -1,9 +1,11 @@
 //! Files in and out, for the command line and the editor alike: scene files read with
 //! their meshes, outputs written atomically ([`write_atomic`]), images encoded
-//! ([`write_image`]), standard output written with its errors checked ([`write_stdout`]).
+//! ([`write_image`]), standard output written with its errors checked ([`write_stdout`]),
+//! and the output policy every command's files go through first ([`OutputPlan`]).
 
 mod atomic;
 mod image;
+pub mod output;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -12,6 +14,7 @@ use tracelab_core::{MeshCache, Scene};
 
 pub use atomic::{AtomicFile, write_atomic};
 pub use image::{ImageWriteError, encode_image, image_format, write_image};
+pub use output::{Implicit, OutputError, OutputPlan, write_implicit};
 
 use crate::exit::Exit;
 
@@ -57,7 +60,25 @@ pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
 /// Reads a scene (`None`: the built-in one) for the command line, printing its warnings to
 /// standard error; errors come back as one message.
 pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
+    load_scene_and_meshes(path).map(|(scene, _)| scene)
+}
+
+/// As [`load_scene`], also giving the OBJ files it read (canonical paths), so that no output
+/// of the command replaces one of them ([`OutputPlan::reads`]).
+pub fn load_scene_and_meshes(path: Option<&Path>) -> anyhow::Result<(Scene, Vec<PathBuf>)> {
+    let read = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let mut cache = MeshCache::new();
+    let seen = read.clone();
+    cache.set_observer(Some(std::sync::Arc::new(
+        move |e: tracelab_core::MeshEvent<'_>| {
+            if let tracelab_core::MeshEvent::Reading { path, .. } = e
+                && let Ok(mut v) = seen.lock()
+            {
+                v.push(path.to_path_buf());
+            }
+            true
+        },
+    )));
     let outcome = match path {
         Some(p) => tracelab_core::load_scene(p, &mut cache),
         None => tracelab_core::parse_scene(
@@ -67,7 +88,9 @@ pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
             &mut cache,
         ),
     };
-    warn_or_fail(outcome)
+    let scene = warn_or_fail(outcome)?;
+    let meshes = read.lock().map(|v| v.clone()).unwrap_or_default();
+    Ok((scene, meshes))
 }
 
 /// Reads a scene without loading its meshes (for `fmt`, which rewrites the text and needs
