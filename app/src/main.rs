@@ -1,6 +1,7 @@
 //! The `tracelab` binary: the command line, and (with no subcommand) the GUI.
 
 fn main() -> std::process::ExitCode {
+    tracelab_core::memory::set_out_of_memory_handler(orderly_oom::report);
     tracelab::cli::main()
 }
 
@@ -15,6 +16,12 @@ mod orderly_oom {
     use std::io::Write;
 
     pub struct Orderly;
+
+    /// A buffer that did not fit, reported by core (`memory::fail_as_infallible`).
+    pub fn report(e: tracelab_core::OutOfMemory) {
+        let _ = writeln!(std::io::stderr().lock(), "tracelab: {e}");
+        std::process::exit(1);
+    }
 
     /// A failed allocation that nobody handles: say so and exit 1. Allocates nothing.
     #[cold]

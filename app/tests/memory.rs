@@ -128,25 +128,47 @@ Group { numObjects 1000000 MaterialIndex 0
     }
     text.push_str("}\n");
     std::fs::write(dir.join("spheres.txt"), text).expect("write scene");
-    let o = tracelab_within(
-        600_000,
-        &[
-            "render",
-            "spheres.txt",
-            "--size",
-            "64",
-            "64",
-            "--output",
-            "s.png",
-        ],
-        &dir,
-    );
-    assert_eq!(o.status.signal(), None, "{:?}: {}", o.status, stderr(&o));
-    assert!(
-        o.status.success()
-            || (o.status.code() == Some(1) && stderr(&o).contains("not enough memory")),
-        "{:?}: {}",
-        o.status,
-        stderr(&o)
-    );
+    let render = [
+        "render",
+        "spheres.txt",
+        "--size",
+        "64",
+        "64",
+        "--output",
+        "s.png",
+    ];
+    let inspect = [
+        "inspect",
+        "spheres.txt",
+        "--size",
+        "64",
+        "64",
+        "--pixel",
+        "3",
+        "3",
+    ];
+    // 600 MB as the issue measured; 300 MB (the parse's objects fail) and 500 MB (inspect's
+    // compile fails) reach the other paths.
+    for (kib, args) in [
+        (600_000, &render[..]),
+        (300_000, &render[..]),
+        (500_000, &inspect[..]),
+    ] {
+        let o = tracelab_within(kib, args, &dir);
+        assert_eq!(
+            o.status.signal(),
+            None,
+            "{args:?}: {:?}: {}",
+            o.status,
+            stderr(&o)
+        );
+        assert!(
+            o.status.success()
+                || (o.status.code() == Some(1) && stderr(&o).contains("not enough memory")),
+            "{args:?} under {kib} KiB: {:?}: {}",
+            o.status,
+            stderr(&o)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -67,6 +67,31 @@ pub fn check_available(bytes: u64, what: &'static str) -> Result<(), OutOfMemory
     Ok(())
 }
 
+/// What the program does when an infallible wrapper (`CompiledScene::new`) runs out of
+/// memory; set once by the binary (a message and exit 1).
+static ON_OUT_OF_MEMORY: std::sync::OnceLock<fn(OutOfMemory)> = std::sync::OnceLock::new();
+
+/// Sets what [`fail_as_infallible`] does before it aborts: the binary prints the message and
+/// exits. The first call wins.
+pub fn set_out_of_memory_handler(handler: fn(OutOfMemory)) {
+    let _ = ON_OUT_OF_MEMORY.set(handler);
+}
+
+/// Ends the process for an infallible wrapper of a fallible builder (`CompiledScene::new`)
+/// that ran out of memory: the handler the binary set (a message, exit 1), else
+/// `handle_alloc_error`, as a failed allocation would.
+pub fn fail_as_infallible(e: OutOfMemory) -> ! {
+    if let Some(handler) = ON_OUT_OF_MEMORY.get() {
+        handler(e);
+    }
+    let size = usize::try_from(e.bytes)
+        .unwrap_or(isize::MAX as usize)
+        .min(isize::MAX as usize);
+    std::alloc::handle_alloc_error(
+        std::alloc::Layout::from_size_align(size, 1).unwrap_or(std::alloc::Layout::new::<u8>()),
+    )
+}
+
 /// Address space a thread's malloc arena reserves (glibc on 64-bit systems: 64 MiB),
 /// counted against a memory limit (`ulimit -v`) whether used or not.
 pub const ARENA_BYTES: u64 = 64 << 20;

@@ -50,13 +50,10 @@ impl Bvh {
             .enumerate()
             .map(|(i, b)| PrimRef::new(*b, i as u32))
             .collect();
-        Self::build_from(prims).unwrap_or_else(|e| {
-            let size = usize::try_from(e.bytes).unwrap_or(usize::MAX >> 1);
-            std::alloc::handle_alloc_error(
-                std::alloc::Layout::from_size_align(size, 1)
-                    .unwrap_or(std::alloc::Layout::new::<u8>()),
-            )
-        })
+        match Self::build_from(prims) {
+            Ok(bvh) => bvh,
+            Err(e) => crate::memory::fail_as_infallible(e),
+        }
     }
 
     /// About what a build over `n` primitives takes at its peak: the primitive references,

@@ -92,16 +92,13 @@ fn reserve_walk<T>(stack: &mut Vec<T>, more: usize) -> Result<(), OutOfMemory> {
 }
 
 impl CompiledScene {
-    /// The scene compiled for rendering; aborts, as any allocation does, where it does not fit
-    /// in memory (see [`CompiledScene::try_new`]).
+    /// The scene compiled for rendering; where it does not fit in memory, ends the process as
+    /// a failed allocation does (see [`CompiledScene::try_new`] for an error instead).
     pub fn new(scene: &Scene) -> Self {
-        Self::try_new(scene).unwrap_or_else(|e| {
-            let size = usize::try_from(e.bytes).unwrap_or(usize::MAX >> 1);
-            std::alloc::handle_alloc_error(
-                std::alloc::Layout::from_size_align(size, 1)
-                    .unwrap_or(std::alloc::Layout::new::<u8>()),
-            )
-        })
+        match Self::try_new(scene) {
+            Ok(compiled) => compiled,
+            Err(e) => crate::memory::fail_as_infallible(e),
+        }
     }
 
     /// [`CompiledScene::new`], with an error instead of an abort where its big arrays (one
