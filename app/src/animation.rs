@@ -1,15 +1,23 @@
 //! Animations for slides: one value of one Transform op swept over N frames, each frame a
 //! full render (or the compare view: (M⁻¹)ᵀ left, M right), written as a PNG sequence and an
 //! animated PNG. Used by `tracelab animate` and the editor's File › Export animation.
+//!
+//! Memory does not grow with the frames: one copy of the scene has the op rewritten frame by
+//! frame, each frame is rendered, written and dropped, and the animated PNG is streamed to
+//! its temporary file frame by frame (put in place only when complete).
 
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use image::RgbImage;
+use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size, try_render_frame};
 use tracelab_core::{
-    CompiledScene, NodeId, NodeKind, NormalTransform, RenderSettings, Scene, TransformOp, View,
-    check_scene, render_frame,
+    CompiledScene, NodeId, NodeKind, NormalTransform, OutOfMemory, RenderSettings, Scene,
+    TransformOp, View, check_scene,
 };
+
+use crate::io::output::check_output_folder;
+use crate::io::{AtomicFile, OutputError, OutputPlan, write_implicit};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
@@ -24,12 +32,17 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// The value in frame `k`: from `from` to `to` inclusive, evenly.
+    /// The value in frame `k`: from `from` to `to` inclusive, evenly. In f64, so that a
+    /// sweep across most of f32's range (-3e38 to 3e38) has finite steps.
     pub fn value(&self, k: u32) -> f32 {
-        if self.frames <= 1 {
+        if self.frames <= 1 || k == 0 {
             return self.from;
         }
-        self.from + (self.to - self.from) * k as f32 / (self.frames - 1) as f32
+        if k >= self.frames - 1 {
+            return self.to;
+        }
+        let (from, to) = (f64::from(self.from), f64::from(self.to));
+        (from + (to - from) * f64::from(k) / f64::from(self.frames - 1)) as f32
     }
 }
 
@@ -74,63 +87,102 @@ pub fn with_component(op: &TransformOp, c: usize, v: f32) -> Option<TransformOp>
     Some(op)
 }
 
-/// The scene of frame `k`, checked against the same rules as every edit.
-pub fn frame_scene(scene: &Scene, sweep: &Sweep, k: u32) -> Result<Scene, String> {
-    let mut s = scene.clone();
-    let v = sweep.value(k);
-    let node = s
-        .graph
-        .get_mut(sweep.node)
-        .ok_or_else(|| format!("node #{} does not exist", sweep.node.0))?;
-    let NodeKind::Transform(ops) = &mut node.kind else {
-        return Err(format!(
-            "node #{} is a {}, not a Transform",
-            sweep.node.0,
-            node.kind.name()
-        ));
-    };
-    let count = ops.len();
-    let op = ops
-        .get_mut(sweep.op)
-        .ok_or_else(|| format!("the Transform has {count} ops: there is no op {}", sweep.op))?;
-    *op = with_component(op, sweep.component, v).ok_or_else(|| {
-        format!(
-            "{} has {} numbers: there is no number {}",
-            op.name(),
-            components(op).len(),
-            sweep.component
-        )
-    })?;
-    if let Some(p) = check_scene(&s).into_iter().find(|p| !p.incomplete) {
-        return Err(format!("frame {k} (value {v}): {}", p.message));
-    }
-    Ok(s)
+/// The frames' scenes, one at a time: a single copy of the scene with the swept op rewritten
+/// for each frame, so that frames share everything that does not change.
+struct FrameScenes {
+    scene: Scene,
+    sweep: Sweep,
 }
 
-/// One frame's picture: the colour image, or the compare view side by side.
-pub fn frame_image(scene: &Scene, settings: &RenderSettings, compare: bool) -> RgbImage {
-    let compiled = CompiledScene::new(scene);
+impl FrameScenes {
+    /// Checks that the sweep names a number of an op of a Transform.
+    fn new(scene: &Scene, sweep: &Sweep) -> Result<Self, String> {
+        let mut frames = FrameScenes {
+            scene: scene.clone(),
+            sweep: sweep.clone(),
+        };
+        frames.op_mut()?;
+        Ok(frames)
+    }
+
+    fn op_mut(&mut self) -> Result<&mut TransformOp, String> {
+        let sweep = &self.sweep;
+        let node = self
+            .scene
+            .graph
+            .get_mut(sweep.node)
+            .ok_or_else(|| format!("node #{} does not exist", sweep.node.0))?;
+        let kind = node.kind.name();
+        let NodeKind::Transform(ops) = &mut node.kind else {
+            return Err(format!(
+                "node #{} is a {kind}, not a Transform",
+                sweep.node.0
+            ));
+        };
+        let count = ops.len();
+        let op = ops
+            .get_mut(sweep.op)
+            .ok_or_else(|| format!("the Transform has {count} ops: there is no op {}", sweep.op))?;
+        if with_component(op, sweep.component, 0.0).is_none() {
+            return Err(format!(
+                "{} has {} numbers: there is no number {}",
+                op.name(),
+                components(op).len(),
+                sweep.component
+            ));
+        }
+        Ok(op)
+    }
+
+    /// The scene of frame `k`, checked against the same rules as every edit.
+    fn frame(&mut self, k: u32) -> Result<&Scene, String> {
+        let v = self.sweep.value(k);
+        let component = self.sweep.component;
+        let op = self.op_mut()?;
+        if let Some(changed) = with_component(op, component, v) {
+            *op = changed;
+        }
+        if let Some(p) = check_scene(&self.scene).into_iter().find(|p| !p.incomplete) {
+            return Err(format!("frame {k} (value {v}): {}", p.message));
+        }
+        Ok(&self.scene)
+    }
+}
+
+/// The scene of frame `k`, checked against the same rules as every edit.
+pub fn frame_scene(scene: &Scene, sweep: &Sweep, k: u32) -> Result<Scene, String> {
+    FrameScenes::new(scene, sweep)?.frame(k).cloned()
+}
+
+/// One frame's picture as RGB bytes: the colour image, or the compare view side by side
+/// (twice as wide). Every big buffer is allocated fallibly.
+pub fn frame_image(
+    scene: &Scene,
+    settings: &RenderSettings,
+    compare: bool,
+) -> Result<Vec<u8>, OutOfMemory> {
+    let compiled = CompiledScene::try_new(scene)?;
     let one = |rule: NormalTransform| {
-        let f = render_frame(
-            &compiled,
-            &RenderSettings {
-                normal_transform: rule,
-                ..*settings
-            },
-        );
-        RgbImage::from_raw(f.width, f.height, f.rgb8(View::Color, (0.0, 1.0))).expect("frame size")
+        let settings = RenderSettings {
+            normal_transform: rule,
+            ..*settings
+        };
+        try_render_frame(&compiled, &settings)?.try_rgb8(View::Color, (0.0, 1.0))
     };
     if !compare {
         return one(settings.normal_transform);
     }
     let (a, b) = (
-        one(NormalTransform::Correct),
-        one(NormalTransform::Incorrect),
+        one(NormalTransform::Correct)?,
+        one(NormalTransform::Incorrect)?,
     );
-    let mut out = RgbImage::new(a.width() * 2, a.height());
-    image::imageops::replace(&mut out, &a, 0, 0);
-    image::imageops::replace(&mut out, &b, i64::from(a.width()), 0);
-    out
+    let row = settings.width as usize * 3;
+    let mut out = tracelab_core::memory::try_with_capacity(a.len() * 2, "the compare view")?;
+    for (ra, rb) in a.chunks_exact(row).zip(b.chunks_exact(row)) {
+        out.extend_from_slice(ra);
+        out.extend_from_slice(rb);
+    }
+    Ok(out)
 }
 
 /// The editor's export form: a sweep, the compare switch and the folder.
@@ -174,85 +226,176 @@ impl AnimationForm {
 
 #[derive(Debug, PartialEq)]
 pub enum AnimateError {
-    Cancelled,
+    Cancelled {
+        /// Frame files written before the cancel (kept; the animated PNG is not written).
+        written: u32,
+    },
+    /// The scene or the sweep cannot make this animation (a frame's value is refused).
     Refused(String),
+    /// The output cannot or may not be written (a name, a folder, a full disk); frames
+    /// written before it are kept.
+    Output(String),
+    OutOfMemory(String),
 }
 
-/// Every frame, in order; `progress(done)` after each. Every frame's scene is checked
-/// before any is rendered, so a sweep through a refused value fails at once.
-pub fn render_frames(
+/// Where an animation goes: `dir/stem_0000.png …` and `dir/stem.apng.png`, `delay_ms` a frame.
+#[derive(Clone, Debug)]
+pub struct Destination {
+    pub dir: PathBuf,
+    pub stem: String,
+    pub delay_ms: u16,
+    /// Files the command reads (the scene, its meshes): never written, whatever the names.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// Checks that a stem names files inside the folder: one plain name, no folder part (`..`,
+/// `/`, an absolute path), nothing a file name cannot hold.
+pub fn check_stem(stem: &str) -> Result<(), String> {
+    let plain = !stem.is_empty()
+        && stem != "."
+        && stem != ".."
+        && !stem.contains(['/', '\\', '\0'])
+        && !stem.chars().any(char::is_control);
+    if plain {
+        Ok(())
+    } else {
+        Err(format!(
+            "--stem {stem:?}: expected a plain file name (no folder, no \"..\", no control characters): \
+             the frames are written inside --out"
+        ))
+    }
+}
+
+/// The picture size of every frame: the render size, twice as wide for the compare view,
+/// checked against the image size limits.
+pub fn frame_size(settings: &RenderSettings, compare: bool) -> Result<(u32, u32), String> {
+    let w = if compare {
+        settings.width.saturating_mul(2)
+    } else {
+        settings.width
+    };
+    check_image_size(w, settings.height).map_err(|e| {
+        if compare {
+            format!(
+                "{e} (the compare view is twice the render's width: at most {} pixels wide \
+                 per rule)",
+                MAX_IMAGE_SIDE / 2
+            )
+        } else {
+            e.to_string()
+        }
+    })?;
+    Ok((w, settings.height))
+}
+
+/// Renders and writes every frame in order, each dropped once written, and the animated PNG
+/// streamed beside them; `progress(done)` after each frame. Every frame's scene is checked
+/// before anything is rendered or written, so a sweep through a refused value fails at once.
+/// Returns the files written, the animated PNG last.
+pub fn export(
     scene: &Scene,
     sweep: &Sweep,
     settings: &RenderSettings,
     compare: bool,
+    to: &Destination,
     cancel: &AtomicBool,
     mut progress: impl FnMut(u32),
-) -> Result<Vec<RgbImage>, AnimateError> {
+) -> Result<Vec<PathBuf>, AnimateError> {
     if sweep.frames == 0 {
         return Err(AnimateError::Refused(
             "an animation needs at least one frame".into(),
         ));
     }
-    let scenes = (0..sweep.frames)
-        .map(|k| frame_scene(scene, sweep, k))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(AnimateError::Refused)?;
-    let mut out = Vec::with_capacity(scenes.len());
-    for (k, s) in scenes.iter().enumerate() {
+    check_stem(&to.stem).map_err(AnimateError::Output)?;
+    let (w, h) = frame_size(settings, compare).map_err(AnimateError::Output)?;
+    let mut scenes = FrameScenes::new(scene, sweep).map_err(AnimateError::Refused)?;
+    for k in 0..sweep.frames {
+        scenes.frame(k).map_err(AnimateError::Refused)?;
+    }
+    let files = frame_files(to, sweep.frames)?;
+    let write_err = |p: &Path, e: &dyn std::fmt::Display| {
+        AnimateError::Output(format!("{}: cannot write: {e}", p.display()))
+    };
+    let apng_path = files.last().cloned().unwrap_or_default();
+    let mut apng_file = BufWriter::new(
+        AtomicFile::create_no_follow(&apng_path).map_err(|e| write_err(&apng_path, &e))?,
+    );
+    let mut apng = apng_writer(&mut apng_file, (w, h), sweep.frames, to.delay_ms)
+        .map_err(|e| write_err(&apng_path, &e))?;
+    for (k, path) in (0..sweep.frames).zip(&files) {
         if cancel.load(Ordering::Relaxed) {
-            return Err(AnimateError::Cancelled);
+            return Err(AnimateError::Cancelled { written: k });
         }
-        out.push(frame_image(s, settings, compare));
-        progress(k as u32 + 1);
+        let scene = scenes.frame(k).map_err(AnimateError::Refused)?;
+        let rgb = frame_image(scene, settings, compare).map_err(|e| {
+            AnimateError::OutOfMemory(format!(
+                "not enough memory to render frame {k} at {w}x{h} (needs about {} MB more)",
+                tracelab_core::memory::megabytes(e.bytes)
+            ))
+        })?;
+        let png = encode_png(&rgb, w, h).map_err(|e| write_err(path, &e))?;
+        write_implicit(path, &png).map_err(|e| write_err(path, &e))?;
+        apng.write_image_data(&rgb)
+            .map_err(|e| write_err(&apng_path, &e))?;
+        progress(k + 1);
     }
-    Ok(out)
+    apng.finish().map_err(|e| write_err(&apng_path, &e))?;
+    apng_file
+        .into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(AtomicFile::commit)
+        .map_err(|e| write_err(&apng_path, &e))?;
+    Ok(files)
 }
 
-/// Writes `dir/stem_0000.png …` and the animated `dir/stem.apng.png`; returns the files.
-pub fn write_frames(
-    frames: &[RgbImage],
-    dir: &Path,
-    stem: &str,
+/// The files an export writes, in order, the animated PNG last, claimed through the output
+/// policy (`io::output`): the folder made and checked, and no invented name that is a
+/// symlink, a folder, a device or FIFO, or an input, refused before any frame is rendered.
+fn frame_files(to: &Destination, frames: u32) -> Result<Vec<PathBuf>, AnimateError> {
+    let refused = |e: OutputError| AnimateError::Output(e.to_string());
+    std::fs::create_dir_all(&to.dir).map_err(|e| {
+        AnimateError::Output(format!("{}: cannot create folder: {e}", to.dir.display()))
+    })?;
+    check_output_folder(&to.dir).map_err(refused)?;
+    let mut plan = OutputPlan::new();
+    for input in &to.inputs {
+        plan.reads(input);
+    }
+    let files: Vec<PathBuf> = (0..frames)
+        .map(|k| to.dir.join(format!("{}_{k:04}.png", to.stem)))
+        .chain([to.dir.join(format!("{}.apng.png", to.stem))])
+        .collect();
+    for p in &files {
+        plan.implicit_exact(p).map_err(refused)?;
+    }
+    Ok(files)
+}
+
+/// An animated PNG's writer (looping forever, `delay_ms` a frame) with its header written;
+/// each `write_image_data` then streams one frame to `out`.
+fn apng_writer<W: Write>(
+    out: W,
+    (w, h): (u32, u32),
+    frames: u32,
     delay_ms: u16,
-) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("{}: cannot create folder: {e}", dir.display()))?;
-    let mut written = Vec::new();
-    for (k, f) in frames.iter().enumerate() {
-        let p = dir.join(format!("{stem}_{k:04}.png"));
-        let mut bytes = Vec::new();
-        f.write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
-        crate::io::write_atomic(&p, &bytes)
-            .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
-        written.push(p);
-    }
-    let p = dir.join(format!("{stem}.apng.png"));
-    let bytes =
-        apng(frames, delay_ms).map_err(|e| format!("{}: cannot encode: {e}", p.display()))?;
-    crate::io::write_atomic(&p, &bytes)
-        .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
-    written.push(p);
-    Ok(written)
+) -> Result<png::Writer<W>, png::EncodingError> {
+    let mut enc = png::Encoder::new(out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_animated(frames.max(1), 0)?;
+    enc.set_frame_delay(delay_ms, 1000)?;
+    enc.write_header()
 }
 
-/// An animated PNG (looping forever), `delay_ms` per frame.
-pub fn apng(frames: &[RgbImage], delay_ms: u16) -> Result<Vec<u8>, png::EncodingError> {
-    let (w, h) = frames.first().map_or((1, 1), |f| f.dimensions());
+/// One frame as a PNG file's bytes.
+fn encode_png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, png::EncodingError> {
     let mut bytes = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut bytes, w, h);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
-        enc.set_animated(frames.len().max(1) as u32, 0)?;
-        enc.set_frame_delay(delay_ms, 1000)?;
         let mut writer = enc.write_header()?;
-        for f in frames {
-            writer.write_image_data(f.as_raw())?;
-        }
+        writer.write_image_data(rgb)?;
         writer.finish()?;
     }
     Ok(bytes)
@@ -277,6 +420,31 @@ mod tests {
             (0..5).map(|k| s.value(k)).collect::<Vec<_>>(),
             [1.0, 1.5, 2.0, 2.5, 3.0]
         );
+    }
+
+    #[test]
+    fn a_sweep_across_most_of_the_f32_range_has_finite_values() {
+        let s = Sweep {
+            node: NodeId(0),
+            op: 0,
+            component: 0,
+            from: -3e38,
+            to: 3e38,
+            frames: 5,
+        };
+        let v: Vec<f32> = (0..5).map(|k| s.value(k)).collect();
+        assert_eq!(v, [-3e38, -1.5e38, 0.0, 1.5e38, 3e38]);
+    }
+
+    #[test]
+    fn a_stem_is_one_plain_file_name() {
+        assert!(check_stem("frame").is_ok());
+        assert!(check_stem("my frames.v2").is_ok());
+        for bad in [
+            "", ".", "..", "../x", "a/b", "/tmp/x", "a\\b", "x\u{7}", "a\0b",
+        ] {
+            assert!(check_stem(bad).is_err(), "{bad:?}");
+        }
     }
 
     #[test]

@@ -238,3 +238,146 @@ fn a_sweep_through_a_refused_value_writes_nothing_and_says_which_frame() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("node #999 does not exist"));
 }
+
+/// `animate ARGS… --node ID --from FROM --to TO --out out` in `dir` on `anim.txt`.
+fn animate(dir: &Path, id: &str, from: &str, to: &str, more: &[&str]) -> Output {
+    std::fs::write(dir.join("anim.txt"), SCENE.replace("VALUE", "0")).expect("write");
+    let mut args = vec![
+        "animate", "anim.txt", "--size", "8", "6", "--node", id, "--from", from, "--to", to,
+        "--frames", "3", "--out", "out",
+    ];
+    args.extend(more);
+    tracelab(&args, dir)
+}
+
+#[test]
+fn a_stem_with_a_folder_part_is_a_usage_error_and_nothing_is_written() {
+    let dir = temp_dir("stem");
+    let id = transform_id(&dir);
+    let abs = dir.join("abs").display().to_string();
+    for stem in ["../x", "a/b", "..", ".", "", abs.as_str(), "x\u{7}"] {
+        let o = animate(&dir, &id, "0", "1", &["--stem", stem]);
+        assert_eq!(o.status.code(), Some(2), "--stem {stem:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("--stem"), "{err}");
+    }
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["anim.txt", "probe.txt"], "nothing written anywhere");
+}
+
+#[test]
+fn a_sweep_across_most_of_f32s_range_has_finite_values() {
+    let dir = temp_dir("wide-sweep");
+    let id = transform_id(&dir);
+    // -3e38 to 3e38: the span (6e38) overflows f32; the middle frame's value is 0.
+    let o = animate(&dir, &id, "-3e38", "3e38", &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("NaN"), "{err}");
+    assert!(o.status.success(), "{err}");
+    // The middle frame is the file's own scene (Translate 0).
+    assert!(
+        tracelab(
+            &[
+                "render", "anim.txt", "--size", "8", "6", "--output", "mid.png"
+            ],
+            &dir
+        )
+        .status
+        .success()
+    );
+    assert_eq!(
+        read(&dir.join("out/frame_0001.png")),
+        read(&dir.join("mid.png"))
+    );
+}
+
+#[test]
+fn a_compare_animation_wider_than_the_side_limit_is_refused_before_anything() {
+    let dir = temp_dir("compare-wide");
+    let id = transform_id(&dir);
+    std::fs::write(dir.join("anim.txt"), SCENE.replace("VALUE", "0")).expect("write");
+    // 10000 a side is allowed; the compare view would be 20000 wide.
+    let o = tracelab(
+        &[
+            "animate",
+            "anim.txt",
+            "--size",
+            "10000",
+            "1",
+            "--node",
+            &id,
+            "--from",
+            "0",
+            "--to",
+            "1",
+            "--compare",
+            "--out",
+            "out",
+        ],
+        &dir,
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("20000x1 is too large"), "{err}");
+    assert!(err.contains("compare view"), "{err}");
+    assert!(!dir.join("out").exists());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_frame_name_that_is_a_symlink_or_the_scene_is_refused_before_rendering() {
+    let dir = temp_dir("frame-link");
+    let id = transform_id(&dir);
+    std::fs::create_dir(dir.join("out")).expect("mkdir");
+    std::fs::write(dir.join("grades.csv"), "keep").expect("write");
+    std::os::unix::fs::symlink("../grades.csv", dir.join("out/frame_0001.png")).expect("link");
+    let o = animate(&dir, &id, "0", "1", &[]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("frame_0001.png: not written: it is a symbolic link"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("grades.csv")).expect("read"),
+        b"keep"
+    );
+    assert!(
+        !dir.join("out/frame_0000.png").exists(),
+        "refused before any frame"
+    );
+    // The scene itself at an invented name (`--out . --stem anim` would not name it, but a
+    // scene called frame.apng.png is named by the animated PNG).
+    let scene = dir.join("out2/frame.apng.png");
+    std::fs::create_dir(dir.join("out2")).expect("mkdir");
+    std::fs::write(&scene, SCENE.replace("VALUE", "0")).expect("write");
+    let o = tracelab(
+        &[
+            "animate",
+            "out2/frame.apng.png",
+            "--size",
+            "8",
+            "6",
+            "--node",
+            &id,
+            "--from",
+            "0",
+            "--to",
+            "1",
+            "--out",
+            "out2",
+        ],
+        &dir,
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("on the command line"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&scene).expect("read"),
+        SCENE.replace("VALUE", "0")
+    );
+}

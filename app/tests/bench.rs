@@ -239,3 +239,33 @@ fn bench_of_a_missing_scene_fails_with_its_name() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("nope.txt"));
 }
+
+#[test]
+fn repeat_threads_and_orbit_beyond_their_caps_are_usage_errors() {
+    let d = quad_scene("caps");
+    for (cmd, flag, value, cap) in [
+        ("bench", "--repeat", "18446744073709551615", "1000000"),
+        ("bench", "--repeat", "1000000000000", "1000000"),
+        ("bench", "--threads", "100000", "1024"),
+        ("bench", "--threads", "-1", "1024"),
+        (
+            "bench-progressive",
+            "--repeat",
+            "18446744073709551615",
+            "1000000",
+        ),
+        ("bench-progressive", "--threads", "1025", "1024"),
+        ("bench-progressive", "--orbit", "100001", "100000"),
+    ] {
+        let o = tracelab(&[cmd, "quad.txt", "--size", "4", "4", flag, value], &d);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{cmd} {flag} {value}: {err}");
+        assert!(err.contains(cap), "{cmd} {flag} {value}: {err}");
+    }
+    let o = tracelab(&["bench", "quad.txt", "--size", "4", "4", "--help"], &d);
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        help.contains("at most 1024") && help.contains("at most 1000000"),
+        "{help}"
+    );
+}

@@ -5,6 +5,7 @@
 pub mod accel;
 pub mod format;
 pub mod geometry;
+pub mod memory;
 pub mod render;
 pub mod scene;
 pub mod simd;
@@ -15,6 +16,7 @@ pub use format::{
     parse_scene, parse_scene_unresolved, rebase_mesh_paths, resolve_meshes, try_write_scene,
     write_scene,
 };
+pub use memory::OutOfMemory;
 pub use render::{
     CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View,
     compile, render_frame, render_progressive,

@@ -45,7 +45,11 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
     }
 
     let t_min = compiled.camera.t_min();
-    let mut buf = vec![f32::INFINITY; w as usize * h as usize];
+    let mut buf = tracelab_core::memory::try_vec(
+        w as usize * h as usize,
+        f32::INFINITY,
+        "the benchmark's hit distances",
+    )?;
     let frame = |buf: &mut Vec<f32>| {
         // The columns' share of every ray, once per frame (bit-identical to `pixel_ray`).
         let rays = compiled.camera.pixel_rays(w, h);

@@ -17,15 +17,48 @@ mod progressive;
 pub use closest_hit::run;
 pub use progressive::run_progressive;
 
+/// Most threads a benchmark starts: more than any machine tracelab runs on has cores, and
+/// few enough that starting them is quick and cannot use up the process ids.
+pub const MAX_THREADS: usize = 1024;
+/// Most timed runs: a million keeps the times' list a few megabytes.
+pub const MAX_REPEAT: usize = 1_000_000;
+/// Most orbit steps.
+pub const MAX_ORBIT: usize = 100_000;
+
+/// A count from 0 to `max` for an option, or clap's usage error (exit 2) naming the cap.
+fn count_up_to(s: &str, max: usize) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("expected a whole number from 0 to {max}"))?;
+    if n > max {
+        return Err(format!("at most {max}"));
+    }
+    Ok(n)
+}
+
+fn threads(s: &str) -> Result<usize, String> {
+    count_up_to(s, MAX_THREADS)
+}
+
+fn repeat(s: &str) -> Result<usize, String> {
+    count_up_to(s, MAX_REPEAT)
+}
+
+fn orbit(s: &str) -> Result<usize, String> {
+    count_up_to(s, MAX_ORBIT)
+}
+
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
     pub scene: PathBuf,
     /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
     #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
     pub size: Vec<u32>,
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    /// Threads, at most 1024.
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = threads)]
     pub threads: usize,
-    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
+    /// Timed frames after a warm-up, at most 1000000.
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true, value_parser = repeat)]
     pub repeat: usize,
     /// Trace 4x2 pixel tiles as 8-ray packets (as Embree's rtcIntersect8 loop does).
     #[arg(long)]
@@ -38,15 +71,16 @@ pub struct ProgressiveArgs {
     /// Image size in pixels (each side 1 to 16384, at most 8192x8192 pixels in all).
     #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [800u32, 800], allow_negative_numbers = true)]
     pub size: Vec<u32>,
-    /// Threads (default: all cores, as the GUI uses).
-    #[arg(long, allow_negative_numbers = true)]
+    /// Threads, at most 1024 (default: all cores, as the GUI uses).
+    #[arg(long, allow_negative_numbers = true, value_parser = threads)]
     pub threads: Option<usize>,
-    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
+    /// Timed runs after a warm-up, at most 1000000.
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true, value_parser = repeat)]
     pub repeat: usize,
     /// Also time a camera orbit of this many steps (a full turn about the scene's centre),
     /// as a middle-drag in the editor makes them: per step, the time to the first (coarse)
-    /// image and to the full one.
-    #[arg(long, allow_negative_numbers = true)]
+    /// image and to the full one. At most 100000.
+    #[arg(long, allow_negative_numbers = true, value_parser = orbit)]
     pub orbit: Option<usize>,
     /// Trace the primary rays one at a time instead of eight at a time (the same image, bit
     /// for bit; to measure what the packets gain).

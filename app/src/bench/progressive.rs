@@ -24,7 +24,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     check_size(w, h)?;
     let scene = load_scene(Some(&b.scene))?;
     let settings = RenderSettings::new(w, h);
-    let target = SharedFrame::new();
+    let target = SharedFrame::try_sized(w, h)?;
     let never = AtomicBool::new(false);
     let tracing = if b.single_rays {
         Tracing::SingleRays
@@ -114,7 +114,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
 fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::Result<()> {
     let root = scene.graph.root();
     let pivot = world_bounds(scene, root).map_or(Vec3::ZERO, |(a, b)| (a + b) * 0.5);
-    let target = SharedFrame::new();
+    let target = SharedFrame::try_sized(settings.width, settings.height)?;
     let never = AtomicBool::new(false);
     let step_scene = |k: usize| {
         let mut s = scene.clone();

@@ -7,9 +7,9 @@ use std::sync::atomic::AtomicBool;
 use tracelab_core::{NodeId, RenderSettings};
 
 use super::render::{NormalMode, ObjectRaysMode};
-use crate::animation::{AnimateError, Sweep, render_frames, write_frames};
+use crate::animation::{AnimateError, Destination, Sweep, check_stem, export, frame_size};
 use crate::exit::{check_size, usage};
-use crate::io::load_scene;
+use crate::io::load_scene_and_meshes;
 
 #[derive(clap::Args, Debug)]
 pub struct AnimateArgs {
@@ -44,6 +44,7 @@ pub struct AnimateArgs {
     /// Folder for FRAMES: STEM_0000.png … and STEM.apng.png.
     #[arg(long, default_value = ".")]
     pub out: PathBuf,
+    /// The frame files' name, a plain file name: they are always written inside --out.
     #[arg(long, default_value = "frame")]
     pub stem: String,
 }
@@ -59,7 +60,15 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     if !a.from.is_finite() || !a.to.is_finite() {
         return Err(usage("--from and --to must be finite numbers"));
     }
-    let scene = load_scene(Some(&a.scene))?;
+    check_stem(&a.stem).map_err(usage)?;
+    let settings = RenderSettings {
+        normal_transform: a.normal_transform.into(),
+        object_rays: a.object_rays.into(),
+        ..RenderSettings::new(w, h)
+    };
+    // The compare view is twice as wide: checked before the scene is read.
+    frame_size(&settings, a.compare).map_err(usage)?;
+    let (scene, meshes) = load_scene_and_meshes(Some(&a.scene))?;
     let sweep = Sweep {
         node: NodeId(a.node),
         op: a.op,
@@ -68,20 +77,22 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
         to: a.to,
         frames: a.frames,
     };
-    let settings = RenderSettings {
-        normal_transform: a.normal_transform.into(),
-        object_rays: a.object_rays.into(),
-        ..RenderSettings::new(w, h)
+    let to = Destination {
+        dir: a.out.clone(),
+        stem: a.stem.clone(),
+        delay_ms: a.delay_ms,
+        inputs: std::iter::once(a.scene.clone()).chain(meshes).collect(),
     };
     let never = AtomicBool::new(false);
-    let frames = match render_frames(&scene, &sweep, &settings, a.compare, &never, |_| {}) {
-        Ok(f) => f,
-        Err(AnimateError::Refused(m)) => return Err(anyhow::anyhow!("{}: {m}", a.scene.display())),
-        Err(AnimateError::Cancelled) => return Err(anyhow::anyhow!("cancelled")),
-    };
-    let files = write_frames(&frames, &a.out, &a.stem, a.delay_ms).map_err(anyhow::Error::msg)?;
-    if let Some(last) = files.last() {
-        eprintln!("wrote {} frames and {}", frames.len(), last.display());
+    match export(&scene, &sweep, &settings, a.compare, &to, &never, |_| {}) {
+        Ok(files) => {
+            if let Some(last) = files.last() {
+                eprintln!("wrote {} frames and {}", files.len() - 1, last.display());
+            }
+            Ok(())
+        }
+        Err(AnimateError::Refused(m)) => Err(anyhow::anyhow!("{}: {m}", a.scene.display())),
+        Err(AnimateError::Output(m) | AnimateError::OutOfMemory(m)) => Err(anyhow::Error::msg(m)),
+        Err(AnimateError::Cancelled { .. }) => Err(anyhow::anyhow!("cancelled")),
     }
-    Ok(())
 }

@@ -364,7 +364,7 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         object_rays: job.object_rays,
         ..RenderSettings::new(job.width, job.height)
     };
-    let frame = render_with_progress(&compiled, &settings);
+    let frame = render_with_progress(&compiled, &settings)?;
     let r = Reference {
         scene: &scene,
         compiled: &compiled,

@@ -152,6 +152,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
     }
     // Before loading, and long before allocating the frame.
     check_size(job.width, job.height)?;
+    check_memory(job.width, job.height)?;
     // Outputs against the scene, each other and their folders before anything is read, then
     // against the meshes the scene turned out to read, before the render.
     let mut plan = OutputPlan::new();
@@ -169,7 +170,9 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         }
         plan.check().map_err(OutputError::into_cli)?;
     }
-    let compiled = CompiledScene::new(&scene);
+    let compiled = CompiledScene::try_new(&scene).map_err(|e| {
+        anyhow::anyhow!("not enough memory to prepare the scene for rendering: {e}")
+    })?;
     let settings = RenderSettings {
         width: job.width,
         height: job.height,
@@ -177,7 +180,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         normal_transform: job.normal_transform,
         object_rays: job.object_rays,
     };
-    let frame = render_with_progress(&compiled, &settings);
+    let frame = render_with_progress(&compiled, &settings)?;
     let save = |view: View, depth: (f32, f32), path: &Path| {
         crate::io::write_image(&frame, view, depth, path).map_err(anyhow::Error::msg)
     };
@@ -193,12 +196,37 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Bytes a `width` × `height` render takes at its peak: the frame, one view's RGB bytes
+/// and their encoded file (at most about as big).
+pub fn render_bytes(width: u32, height: u32) -> u64 {
+    let rgb = u64::from(width) * u64::from(height) * 3;
+    tracelab_core::Frame::bytes(width, height) + 2 * rgb
+}
+
+fn out_of_memory(width: u32, height: u32) -> anyhow::Error {
+    anyhow::anyhow!(
+        "not enough memory to render {width}x{height} (needs about {} MB)",
+        tracelab_core::memory::megabytes(render_bytes(width, height))
+    )
+}
+
+/// Whether a render of this size fits in the memory to be had now, checked before the scene
+/// is read: a message then, not an abort half-way.
+pub(super) fn check_memory(width: u32, height: u32) -> anyhow::Result<()> {
+    tracelab_core::memory::check_available(render_bytes(width, height), "a render")
+        .map_err(|_| out_of_memory(width, height))
+}
+
 /// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
+/// The frame is allocated fallibly.
 pub(super) fn render_with_progress(
     scene: &CompiledScene,
     settings: &RenderSettings,
-) -> tracelab_core::Frame {
-    let target = Arc::new(SharedFrame::new());
+) -> anyhow::Result<tracelab_core::Frame> {
+    let target = Arc::new(
+        SharedFrame::try_sized(settings.width, settings.height)
+            .map_err(|_| out_of_memory(settings.width, settings.height))?,
+    );
     let done = Arc::new(AtomicBool::new(false));
     let watcher = std::io::stderr().is_terminal().then(|| {
         let (target, done) = (target.clone(), done.clone());
@@ -230,5 +258,8 @@ pub(super) fn render_with_progress(
     if let Some(w) = watcher {
         let _ = w.join();
     }
-    std::mem::replace(&mut *target.lock(), tracelab_core::Frame::new(0, 0))
+    Ok(std::mem::replace(
+        &mut *target.lock(),
+        tracelab_core::Frame::new(0, 0),
+    ))
 }

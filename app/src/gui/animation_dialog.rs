@@ -10,7 +10,7 @@ use std::sync::mpsc::{Receiver, channel};
 use tracelab_core::{NodeKind, RenderSettings, Scene};
 
 pub use crate::animation::AnimationForm;
-use crate::animation::{AnimateError, components, render_frames, write_frames};
+use crate::animation::{AnimateError, Destination, components, export};
 use crate::gui::command::AppCommand;
 
 /// An export under way.
@@ -22,34 +22,44 @@ pub struct Running {
 }
 
 impl Running {
-    /// Renders and writes on a thread of its own.
-    pub fn start(scene: Arc<Scene>, form: &AnimationForm, settings: RenderSettings) -> Running {
+    /// Renders and writes on a thread of its own; `inputs` (the open file) are never written.
+    pub fn start(
+        scene: Arc<Scene>,
+        form: &AnimationForm,
+        settings: RenderSettings,
+        inputs: Vec<PathBuf>,
+    ) -> Running {
         let (tx, rx) = channel();
         let done = Arc::new(AtomicU32::new(0));
         let cancel = Arc::new(AtomicBool::new(false));
-        let (d, c, sweep, compare, folder) = (
-            done.clone(),
-            cancel.clone(),
-            form.sweep(),
-            form.compare,
-            PathBuf::from(&form.folder),
-        );
+        let (d, c, sweep, compare) = (done.clone(), cancel.clone(), form.sweep(), form.compare);
+        let to = Destination {
+            dir: PathBuf::from(&form.folder),
+            stem: "frame".into(),
+            delay_ms: 100,
+            inputs,
+        };
         std::thread::spawn(move || {
-            let out = match render_frames(&scene, &sweep, &settings, compare, &c, |k| {
-                d.store(k, Ordering::Relaxed)
-            }) {
-                Ok(frames) => write_frames(&frames, &folder, "frame", 100).map(|files| {
-                    format!(
-                        "exported {} frames to {} ({})",
-                        frames.len(),
-                        folder.display(),
-                        files
-                            .last()
-                            .map_or(String::new(), |f| f.display().to_string())
-                    )
-                }),
-                Err(AnimateError::Cancelled) => Err("animation export cancelled".into()),
-                Err(AnimateError::Refused(m)) => Err(format!("animation not exported: {m}")),
+            let progress = |k| d.store(k, Ordering::Relaxed);
+            let out = match export(&scene, &sweep, &settings, compare, &to, &c, progress) {
+                Ok(files) => Ok(format!(
+                    "exported {} frames to {} ({})",
+                    files.len().saturating_sub(1),
+                    to.dir.display(),
+                    files
+                        .last()
+                        .map_or(String::new(), |f| f.display().to_string())
+                )),
+                Err(AnimateError::Cancelled { written }) => Err(format!(
+                    "animation export cancelled: {written} frame files written to {}, no \
+                     animated PNG",
+                    to.dir.display()
+                )),
+                Err(
+                    AnimateError::Refused(m)
+                    | AnimateError::Output(m)
+                    | AnimateError::OutOfMemory(m),
+                ) => Err(format!("animation not exported: {m}")),
             };
             let _ = tx.send(out);
         });

@@ -288,6 +288,7 @@ impl TracelabApp {
                         Arc::new(self.doc.scene.clone()),
                         &form,
                         settings,
+                        self.doc.path.iter().cloned().collect(),
                     ));
                     self.animation = Some(form);
                 }

@@ -1,5 +1,6 @@
 //! Writing files without losing them: every output of tracelab (rendered images, `fmt -o`,
-//! the editor's Save, Save As and Export view) goes through [`write_atomic`].
+//! the editor's Save, Save As and Export view) goes through [`write_atomic`], or, when it is
+//! written piece by piece (an animation's APNG), through [`AtomicFile`] under the same rules.
 //!
 //! A regular file (or a new one) is replaced atomically: the bytes go to an exclusively
 //! created temporary file with an unpredictable name in the target's own folder, which is
@@ -23,14 +24,148 @@ const MAX_SYMLINKS: usize = 40;
 /// Replaces `path` with `bytes`, or writes them into it if it is a device or FIFO; see the
 /// module comment for the rules.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let (target, existing) = resolve_symlinks(path)?;
-    match &existing {
-        Some(meta) if meta.is_dir() => Err(io::Error::new(
-            io::ErrorKind::IsADirectory,
-            "is a directory",
-        )),
-        Some(meta) if !meta.is_file() => write_in_place(&target, bytes),
-        _ => replace(&target, existing.as_ref(), bytes),
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(bytes)?;
+    file.commit()
+}
+
+/// An output written piece by piece (an animated PNG, frame after frame, so that memory does
+/// not grow with the frames) and put in place by [`AtomicFile::commit`] under the same rules
+/// as [`write_atomic`]. Dropped without a commit, it leaves the old file as it was and no
+/// temporary file (a device or FIFO keeps what was written into it).
+pub struct AtomicFile {
+    out: Out,
+}
+
+enum Out {
+    /// A device node or FIFO: written into as a shell redirection would.
+    InPlace(File),
+    /// Linux: an unnamed file (`O_TMPFILE`) in the target's folder, named only at commit.
+    #[cfg(target_os = "linux")]
+    Unnamed {
+        file: File,
+        folder: File,
+        dir: PathBuf,
+        target: PathBuf,
+        existing: Option<Metadata>,
+    },
+    /// A named temporary file (`.tracelab-*.tmp`) in the target's folder.
+    Named {
+        tmp: tempfile::NamedTempFile,
+        dir: PathBuf,
+        target: PathBuf,
+        existing: Option<Metadata>,
+    },
+}
+
+impl AtomicFile {
+    /// Follows symlinks from `path` to the file they name and opens where its bytes will go.
+    pub fn create(path: &Path) -> io::Result<AtomicFile> {
+        let (target, existing) = resolve_symlinks(path)?;
+        let out = match &existing {
+            Some(meta) if meta.is_dir() => {
+                return Err(io::Error::new(
+                    io::ErrorKind::IsADirectory,
+                    "is a directory",
+                ));
+            }
+            Some(meta) if !meta.is_file() => {
+                Out::InPlace(std::fs::OpenOptions::new().write(true).open(&target)?)
+            }
+            _ => temporary(target, existing)?,
+        };
+        Ok(AtomicFile { out })
+    }
+
+    /// As [`AtomicFile::create`] for a name tracelab invents (`io::output`): a symlink there
+    /// is not followed but replaced at commit, its target untouched; a folder, device or
+    /// FIFO is refused.
+    pub fn create_no_follow(path: &Path) -> io::Result<AtomicFile> {
+        let existing = match std::fs::symlink_metadata(path) {
+            Ok(m) if m.is_file() => Some(m),
+            Ok(m) if m.file_type().is_symlink() => None,
+            Ok(_) => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    "not a regular file",
+                ));
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(e),
+        };
+        Ok(AtomicFile {
+            out: temporary(path.to_path_buf(), existing)?,
+        })
+    }
+
+    /// Flushes, syncs and puts the file in place (or, for a device or FIFO, flushes it).
+    pub fn commit(self) -> io::Result<()> {
+        match self.out {
+            Out::InPlace(mut file) => {
+                file.flush()?;
+                match file.sync_all() {
+                    // Character devices and FIFOs have nothing to sync and say so with EINVAL.
+                    Err(e)
+                        if e.kind() == io::ErrorKind::InvalidInput
+                            || e.kind() == io::ErrorKind::Unsupported =>
+                    {
+                        Ok(())
+                    }
+                    other => other,
+                }
+            }
+            #[cfg(target_os = "linux")]
+            Out::Unnamed {
+                mut file,
+                folder,
+                dir,
+                target,
+                existing,
+            } => {
+                file.flush()?;
+                if let Some(meta) = &existing {
+                    keep_mode_and_owner(&file, meta)?;
+                }
+                file.sync_all()?;
+                test_stall();
+                match unnamed::link_in_place(&file, &folder, &target) {
+                    Some(done) => done.and_then(|()| folder.sync_all()),
+                    // Neither /proc nor the privilege to name it: copy it to a named file.
+                    None => {
+                        use std::io::Seek;
+                        file.seek(io::SeekFrom::Start(0))?;
+                        let mut named = named_temporary(&dir)?;
+                        io::copy(&mut file, &mut named)?;
+                        commit_named(named, &dir, &target, existing.as_ref())
+                    }
+                }
+            }
+            Out::Named {
+                tmp,
+                dir,
+                target,
+                existing,
+            } => commit_named(tmp, &dir, &target, existing.as_ref()),
+        }
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match &mut self.out {
+            Out::InPlace(f) => f.write(buf),
+            #[cfg(target_os = "linux")]
+            Out::Unnamed { file, .. } => file.write(buf),
+            Out::Named { tmp, .. } => tmp.write(buf),
+        }
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        match &mut self.out {
+            Out::InPlace(f) => f.flush(),
+            #[cfg(target_os = "linux")]
+            Out::Unnamed { file, .. } => file.flush(),
+            Out::Named { tmp, .. } => tmp.flush(),
+        }
     }
 }
 
@@ -38,19 +173,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 /// replaced, its target untouched): for names tracelab invents (`io::output`). A folder,
 /// device or FIFO is refused.
 pub(super) fn write_atomic_no_follow(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let existing = match std::fs::symlink_metadata(path) {
-        Ok(m) if m.is_file() => Some(m),
-        Ok(m) if m.file_type().is_symlink() => None,
-        Ok(_) => {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                "not a regular file",
-            ));
-        }
-        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
-        Err(e) => return Err(e),
-    };
-    replace(path, existing.as_ref(), bytes)
+    let mut file = AtomicFile::create_no_follow(path)?;
+    file.write_all(bytes)?;
+    file.commit()
 }
 
 /// What `path` finally names once its symlinks are followed (itself when it is not a link
@@ -84,35 +209,31 @@ fn resolve_symlinks(path: &Path) -> io::Result<(PathBuf, Option<Metadata>)> {
     )))
 }
 
-/// A device node or FIFO: write into it as a shell redirection would.
-fn write_in_place(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
-    file.write_all(bytes)?;
-    file.flush()?;
-    match file.sync_all() {
-        // Character devices and FIFOs have nothing to sync and say so with EINVAL.
-        Err(e)
-            if e.kind() == io::ErrorKind::InvalidInput
-                || e.kind() == io::ErrorKind::Unsupported =>
-        {
-            Ok(())
-        }
-        other => other,
-    }
-}
-
-/// A regular file or a new one: temporary file, sync, rename, sync the folder.
-fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Result<()> {
+/// The temporary file for a regular file or a new one, in the target's own folder.
+fn temporary(target: PathBuf, existing: Option<Metadata>) -> io::Result<Out> {
     let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
     };
     #[cfg(target_os = "linux")]
-    if let Some(name) = target.file_name()
-        && let Some(done) = unnamed::replace(dir, name, existing, bytes)
-    {
-        return done;
+    if let Some((file, folder)) = unnamed::create(&dir)? {
+        return Ok(Out::Unnamed {
+            file,
+            folder,
+            dir,
+            target,
+            existing,
+        });
     }
+    Ok(Out::Named {
+        tmp: named_temporary(&dir)?,
+        dir,
+        target,
+        existing,
+    })
+}
+
+fn named_temporary(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
     let mut builder = tempfile::Builder::new();
     builder.prefix(".tracelab-").suffix(".tmp");
     #[cfg(unix)]
@@ -121,8 +242,16 @@ fn replace(target: &Path, existing: Option<&Metadata>, bytes: &[u8]) -> io::Resu
         // A new file gets the usual 0666 less the umask, not tempfile's private 0600.
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
+    builder.tempfile_in(dir)
+}
+
+/// Flush, sync, rename over the target, sync the folder.
+fn commit_named(
+    mut tmp: tempfile::NamedTempFile,
+    dir: &Path,
+    target: &Path,
+    existing: Option<&Metadata>,
+) -> io::Result<()> {
     tmp.flush()?;
     if let Some(meta) = existing {
         keep_mode_and_owner(tmp.as_file(), meta)?;
@@ -147,57 +276,42 @@ fn test_stall() {
 /// The Linux path: `O_TMPFILE`, then `linkat` to a fresh name and `renameat` over the target.
 #[cfg(target_os = "linux")]
 mod unnamed {
-    use std::ffi::OsStr;
-    use std::fs::{File, Metadata};
-    use std::io::{self, Write};
+    use std::fs::File;
+    use std::io;
     use std::os::fd::AsRawFd;
     use std::path::Path;
 
     use rustix::fs::{AtFlags, CWD, Mode, OFlags};
     use rustix::io::Errno;
 
-    /// None where the folder's file system (or a missing /proc) does not allow an unnamed
-    /// file to be linked: the caller then uses a named temporary file.
-    pub fn replace(
-        dir: &Path,
-        name: &OsStr,
-        existing: Option<&Metadata>,
-        bytes: &[u8],
-    ) -> Option<io::Result<()>> {
-        let folder = match File::open(dir) {
-            Ok(f) => f,
-            Err(e) => return Some(Err(e)),
-        };
+    /// An unnamed file in `dir` and the folder, or None where the folder's file system does
+    /// not make them (the caller then uses a named temporary file). Read-write, so that it
+    /// can be copied to a named one should it turn out that it cannot be linked.
+    pub fn create(dir: &Path) -> io::Result<Option<(File, File)>> {
+        let folder = File::open(dir)?;
         // 0666 less the umask, as for any new file.
-        let flags = OFlags::WRONLY | OFlags::TMPFILE | OFlags::CLOEXEC;
-        let fd = match rustix::fs::openat(&folder, ".", flags, Mode::from_raw_mode(0o666)) {
-            Ok(fd) => fd,
-            Err(Errno::OPNOTSUPP | Errno::ISDIR | Errno::INVAL | Errno::NOENT) => return None,
-            Err(e) => return Some(Err(e.into())),
-        };
-        let mut file = File::from(fd);
-        let written = (|| {
-            file.write_all(bytes)?;
-            file.flush()?;
-            if let Some(meta) = existing {
-                super::keep_mode_and_owner(&file, meta)?;
-            }
-            file.sync_all()
-        })();
-        if let Err(e) = written {
-            return Some(Err(e)); // the unnamed file goes with its descriptor
+        let flags = OFlags::RDWR | OFlags::TMPFILE | OFlags::CLOEXEC;
+        match rustix::fs::openat(&folder, ".", flags, Mode::from_raw_mode(0o666)) {
+            Ok(fd) => Ok(Some((File::from(fd), folder))),
+            Err(Errno::OPNOTSUPP | Errno::ISDIR | Errno::INVAL | Errno::NOENT) => Ok(None),
+            Err(e) => Err(e.into()),
         }
-        super::test_stall();
-        let temp = link(&file, &folder)?;
-        let moved = match temp {
-            Ok(temp) => rustix::fs::renameat(&folder, &temp, &folder, name)
+    }
+
+    /// Links the complete file under a fresh name and renames that over `target`; None when
+    /// it cannot be named (see [`link`]).
+    pub fn link_in_place(file: &File, folder: &File, target: &Path) -> Option<io::Result<()>> {
+        let name = match target.file_name() {
+            Some(n) => n,
+            None => return Some(Err(io::Error::other("no file name"))),
+        };
+        Some(link(file, folder)?.and_then(|temp| {
+            rustix::fs::renameat(folder, &temp, folder, name)
                 .map_err(io::Error::from)
                 .inspect_err(|_| {
-                    let _ = rustix::fs::unlinkat(&folder, &temp, AtFlags::empty());
-                }),
-            Err(e) => Err(e),
-        };
-        Some(moved.and_then(|()| folder.sync_all()))
+                    let _ = rustix::fs::unlinkat(folder, &temp, AtFlags::empty());
+                })
+        }))
     }
 
     /// Gives the unnamed file a fresh name in `folder` (linkat never replaces an existing
@@ -384,6 +498,29 @@ mod tests {
         write_atomic(&d.join("out.txt"), b"data").expect("write");
         assert_eq!(std::fs::read(d.join("victim")).expect("read"), b"keep");
         assert_eq!(std::fs::read(d.join("out.txt")).expect("read"), b"data");
+    }
+
+    #[test]
+    fn a_streamed_file_appears_only_when_committed() {
+        let d = temp_dir("stream");
+        let p = d.join("anim.png");
+        std::fs::write(&p, "old").expect("write");
+        let mut f = AtomicFile::create(&p).expect("create");
+        f.write_all(b"frame 1, ").expect("write");
+        f.write_all(b"frame 2").expect("write");
+        assert_eq!(std::fs::read(&p).expect("read"), b"old", "not yet");
+        drop(f);
+        assert_eq!(
+            std::fs::read(&p).expect("read"),
+            b"old",
+            "dropped: untouched"
+        );
+        assert_eq!(names_in(&d), ["anim.png"], "and no temporary file");
+        let mut f = AtomicFile::create(&p).expect("create");
+        f.write_all(b"frame 1, frame 2").expect("write");
+        f.commit().expect("commit");
+        assert_eq!(std::fs::read(&p).expect("read"), b"frame 1, frame 2");
+        assert_eq!(names_in(&d), ["anim.png"]);
     }
 
     #[test]

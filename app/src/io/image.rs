@@ -71,8 +71,17 @@ pub fn encode_image(
             ),
         ));
     }
-    let rgb = frame.rgb8(view, depth);
-    let mut out = Vec::new();
+    // Fallibly, as every big buffer: a frame too big for memory is an error, not an abort.
+    let no_memory = |_| {
+        image::ImageError::Limits(image::error::LimitError::from_kind(
+            image::error::LimitErrorKind::InsufficientMemory,
+        ))
+    };
+    let rgb = frame.try_rgb8(view, depth).map_err(no_memory)?;
+    // Room for an incompressible image and the format's overhead, so that it seldom grows.
+    let room = rgb.len() + rgb.len() / 64 + h as usize * 4 + 4096;
+    let mut out =
+        tracelab_core::memory::try_with_capacity(room, "the encoded image").map_err(no_memory)?;
     let color = image::ExtendedColorType::Rgb8;
     match format {
         image::ImageFormat::Pnm => PnmEncoder::new(&mut out)

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use tracelab_core::{MeshCache, Scene};
 
-pub use atomic::write_atomic;
+pub use atomic::{AtomicFile, write_atomic};
 pub use image::{ImageWriteError, encode_image, image_format, write_image};
 pub use output::{Implicit, OutputError, OutputPlan, write_implicit};
 

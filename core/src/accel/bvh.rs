@@ -45,20 +45,55 @@ pub struct Bvh {
 impl Bvh {
     /// Builds over `bounds` (one box per primitive; id = position in the slice).
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let mut prims: Vec<PrimRef> = bounds
+        let prims = bounds
             .iter()
             .enumerate()
             .map(|(i, b)| PrimRef::new(*b, i as u32))
             .collect();
-        let Some(root) = sah::build(&mut prims, sah::LeafBlock(1)) else {
-            return Bvh::default();
-        };
-        let mut nodes = Vec::new();
-        flatten(&root, &mut nodes);
-        Bvh {
-            nodes,
-            indices: prims.iter().map(|p| p.id).collect(),
+        match Self::build_from(prims) {
+            Ok(bvh) => bvh,
+            Err(e) => crate::memory::fail_as_infallible(e),
         }
+    }
+
+    /// About what a build over `n` primitives takes at its peak: the primitive references,
+    /// the builder's tree (up to 2n − 1 nodes, each its own allocation) and the flat nodes.
+    pub fn build_bytes(n: usize) -> u64 {
+        let per_prim = std::mem::size_of::<PrimRef>()
+            + 2 * (std::mem::size_of::<sah::Node>() + 16)
+            + 2 * std::mem::size_of::<BvhNode>()
+            + std::mem::size_of::<u32>();
+        (n as u64).saturating_mul(per_prim as u64)
+    }
+
+    /// [`Bvh::build`], or an error where it would not fit in memory: checked as a whole
+    /// before starting, since the builder's tree is millions of small allocations.
+    pub fn try_build(bounds: &[Aabb]) -> Result<Bvh, crate::memory::OutOfMemory> {
+        // The builder allocates on every thread.
+        crate::memory::check_available_threaded(
+            Self::build_bytes(bounds.len()),
+            "the scene's BVH",
+        )?;
+        let mut prims = crate::memory::try_with_capacity(bounds.len(), "the scene's BVH")?;
+        prims.extend(
+            bounds
+                .iter()
+                .enumerate()
+                .map(|(i, b)| PrimRef::new(*b, i as u32)),
+        );
+        Self::build_from(prims)
+    }
+
+    fn build_from(mut prims: Vec<PrimRef>) -> Result<Bvh, crate::memory::OutOfMemory> {
+        let Some(root) = sah::build(&mut prims, sah::LeafBlock(1)) else {
+            return Ok(Bvh::default());
+        };
+        // A binary tree over n leaves has 2n − 1 nodes: no doubling slack.
+        let mut nodes = crate::memory::try_with_capacity(2 * prims.len() - 1, "the scene's BVH")?;
+        flatten(&root, &mut nodes);
+        let mut indices = crate::memory::try_with_capacity(prims.len(), "the scene's BVH")?;
+        indices.extend(prims.iter().map(|p| p.id));
+        Ok(Bvh { nodes, indices })
     }
 
     pub fn bounds(&self) -> Aabb {

@@ -147,6 +147,7 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
         diags: Vec::new(),
         unshown: Unshown::default(),
         fatal: false,
+        out_of_memory: false,
         camera: None,
         camera_seen: false,
         group_seen: false,
@@ -180,6 +181,8 @@ struct Parser<'a> {
     unshown: Unshown,
     /// Set by any error that leaves the scene incomplete.
     fatal: bool,
+    /// The scene's objects outgrew the memory there is: the parse stops there.
+    out_of_memory: bool,
     camera: Option<Camera>,
     /// A camera or object Group block was present (even if broken): do not also report it missing.
     camera_seen: bool,
@@ -325,6 +328,10 @@ impl<'a> Parser<'a> {
     // ---------------------------------------------------------------- tokens and messages
 
     fn peek(&self) -> Option<Token> {
+        // Out of memory, the parse stops: the rest of the file is not read.
+        if self.out_of_memory {
+            return None;
+        }
         self.toks.get(self.pos)
     }
 
@@ -1095,7 +1102,7 @@ impl<'a> Parser<'a> {
             count: 0,
             material: None,
         }];
-        while !stack.is_empty() {
+        while !stack.is_empty() && !self.out_of_memory {
             let Some(t) = self.next() else {
                 let (kind, open) = match stack.last() {
                     Some(OpenBlock::Group { open, .. }) => ("Group", *open),
@@ -1407,15 +1414,39 @@ impl<'a> Parser<'a> {
         let before = self.comments_here();
         let open = self.expect_open(w)?;
         let attach = |this: &mut Self, graph: &mut Graph, kind: NodeKind, comments: Comments| {
-            let id = graph.add(Node {
-                kind,
-                material,
-                children: Vec::new(),
-                comments,
+            // The arrays that grow with every object, fallibly: a scene too big for the
+            // memory there is ends the parse with a message, not an abort.
+            let id = crate::memory::fallibly(|| {
+                this.node_offsets
+                    .try_reserve(1)
+                    .and_then(|()| this.leaf_offsets.try_reserve(1))
+            })
+            .map_err(|_| crate::memory::OutOfMemory {
+                what: "the scene's objects",
+                bytes: (this.node_offsets.len() * 24) as u64,
+            })
+            .and_then(|()| {
+                graph.try_add(Node {
+                    kind,
+                    material,
+                    children: Vec::new(),
+                    comments,
+                })
             });
+            let id = match id {
+                Ok(id) => id,
+                Err(e) => {
+                    this.error(
+                        off,
+                        format!("{e}: the scene has more objects than fit in memory here"),
+                    );
+                    this.out_of_memory = true;
+                    return None;
+                }
+            };
             graph.push_child(parent, id);
             this.record_offset(id, off);
-            id
+            Some(id)
         };
         if let Some(op) = CsgOp::from_name(w) {
             let node = attach(
@@ -1426,7 +1457,7 @@ impl<'a> Parser<'a> {
                     before,
                     ..Comments::default()
                 },
-            );
+            )?;
             return Some(OpenBlock::Csg {
                 node,
                 op,
@@ -1446,7 +1477,7 @@ impl<'a> Parser<'a> {
                         before,
                         ..Comments::default()
                     },
-                );
+                )?;
                 Some(OpenBlock::Group {
                     node,
                     open,
@@ -1464,7 +1495,7 @@ impl<'a> Parser<'a> {
                         before,
                         ..Comments::default()
                     },
-                );
+                )?;
                 Some(OpenBlock::Transform {
                     node,
                     keyword: off,
@@ -1477,7 +1508,7 @@ impl<'a> Parser<'a> {
                 let (kind, mut comments) = self.parse_primitive(w, off, open)?;
                 comments.before = before;
                 let is_mesh = matches!(kind, NodeKind::TriangleMesh { .. });
-                let id = attach(self, graph, kind, comments);
+                let id = attach(self, graph, kind, comments)?;
                 self.leaf_offsets.push((id, off));
                 if is_mesh {
                     self.mesh_name_offsets.push((id, self.last_obj_name));

@@ -15,6 +15,7 @@ use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere,
     intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
 };
+use crate::memory::{OutOfMemory, try_with_capacity};
 use crate::scene::validate::compose_f64;
 use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
 
@@ -81,15 +82,41 @@ pub struct CompiledScene {
     single_mesh: Option<u32>,
 }
 
+/// Room on the compile walk's stack for `more` children (a Group of a million spheres puts
+/// a million matrices there), fallibly.
+fn reserve_walk<T>(stack: &mut Vec<T>, more: usize) -> Result<(), OutOfMemory> {
+    crate::memory::fallibly(|| stack.try_reserve(more)).map_err(|_| OutOfMemory {
+        what: "the scene's objects",
+        bytes: ((stack.len() + more) * std::mem::size_of::<T>()) as u64,
+    })
+}
+
 impl CompiledScene {
+    /// The scene compiled for rendering; where it does not fit in memory, ends the process as
+    /// a failed allocation does (see [`CompiledScene::try_new`] for an error instead).
     pub fn new(scene: &Scene) -> Self {
+        match Self::try_new(scene) {
+            Ok(compiled) => compiled,
+            Err(e) => crate::memory::fail_as_infallible(e),
+        }
+    }
+
+    /// [`CompiledScene::new`], with an error instead of an abort where its big arrays (one
+    /// entry per object, and the BVH) do not fit in memory.
+    pub fn try_new(scene: &Scene) -> Result<Self, OutOfMemory> {
         let mut materials: Vec<Vec3> = scene.materials.iter().map(|m| m.diffuse).collect();
         let default_material = materials.len() as u32;
         materials.push(DEFAULT_MATERIAL_COLOR);
         let n_mat = scene.materials.len() as u32;
 
         let g = &scene.graph;
-        let mut objects = Vec::new();
+        // Every object node at most once (a CSG's operands are one object with it): reserved
+        // whole, since grown by doubling the array would at its last step need 1.5 times it.
+        let most = g
+            .iter()
+            .filter(|(_, n)| !matches!(n.kind, NodeKind::Group | NodeKind::Transform(_)))
+            .count();
+        let mut objects: Vec<Object> = try_with_capacity(most, "the scene's objects")?;
         // (node, world_from_object, material in effect)
         let mut stack = vec![(g.root(), DMat4::IDENTITY, None::<u32>)];
         while let Some((id, m, inherited)) = stack.pop() {
@@ -97,13 +124,16 @@ impl CompiledScene {
             let material = node.material.or(inherited);
             let shape = match &node.kind {
                 NodeKind::Group => {
-                    for (c, inherited) in g.list_materials(node, material).into_iter().rev() {
+                    let children = g.list_materials(node, material);
+                    reserve_walk(&mut stack, children.len())?;
+                    for (c, inherited) in children.into_iter().rev() {
                         stack.push((c, m, inherited));
                     }
                     continue;
                 }
                 NodeKind::Transform(ops) => {
                     let m = m * compose_f64(ops);
+                    reserve_walk(&mut stack, node.children.len())?;
                     for &c in node.children.iter().rev() {
                         stack.push((c, m, material));
                     }
@@ -164,8 +194,8 @@ impl CompiledScene {
             });
         }
 
-        let mut bounded_boxes = Vec::new();
-        let mut bounded_ids = Vec::new();
+        let mut bounded_boxes = try_with_capacity(objects.len(), "the objects' bounds")?;
+        let mut bounded_ids = try_with_capacity(objects.len(), "the objects' bounds")?;
         let mut unbounded = Vec::new();
         for (i, o) in objects.iter().enumerate() {
             let b = object_bounds(o);
@@ -176,7 +206,7 @@ impl CompiledScene {
                 unbounded.push(i as u32);
             }
         }
-        let mut bvh = Bvh::build(&bounded_boxes);
+        let mut bvh = Bvh::try_build(&bounded_boxes)?;
         // The BVH indexes `bounded_boxes`; point it at object ids instead.
         for p in &mut bvh.indices {
             *p = bounded_ids[*p as usize];
@@ -192,7 +222,7 @@ impl CompiledScene {
             .iter()
             .map(|l| (-unit(l.direction).unwrap_or(Vec3::NEG_Z), l.color))
             .collect();
-        CompiledScene {
+        Ok(CompiledScene {
             camera: CameraRays::new(&scene.camera),
             background: scene.background_color(),
             ambient: scene.effective_ambient(),
@@ -202,7 +232,7 @@ impl CompiledScene {
             bvh,
             unbounded,
             single_mesh,
-        }
+        })
     }
 
     /// The closest hit with t in (t_min, t_max).

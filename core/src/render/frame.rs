@@ -3,6 +3,8 @@
 
 use glam::Vec3;
 
+use crate::memory::{OutOfMemory, try_vec, try_with_capacity};
+
 /// One pixel's results.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
@@ -65,6 +67,24 @@ impl Frame {
         }
     }
 
+    /// [`Frame::new`], or an error where the samples do not fit in memory.
+    pub fn try_new(width: u32, height: u32) -> Result<Self, OutOfMemory> {
+        Ok(Frame {
+            width,
+            height,
+            samples: try_vec(
+                width as usize * height as usize,
+                Sample::UNSET,
+                "the frame's samples",
+            )?,
+        })
+    }
+
+    /// Bytes a `width` × `height` frame takes.
+    pub fn bytes(width: u32, height: u32) -> u64 {
+        u64::from(width) * u64::from(height) * std::mem::size_of::<Sample>() as u64
+    }
+
     pub fn get(&self, x: u32, row: u32) -> Option<&Sample> {
         if x >= self.width || row >= self.height {
             return None;
@@ -76,6 +96,18 @@ impl Frame {
     /// RGB8 bytes of one view, rows top to bottom. `depth` is (min, max) for the depth view.
     pub fn rgb8(&self, view: View, depth: (f32, f32)) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.samples.len() * 3);
+        self.rgb8_into(view, depth, &mut out);
+        out
+    }
+
+    /// [`Frame::rgb8`], or an error where the bytes do not fit in memory.
+    pub fn try_rgb8(&self, view: View, depth: (f32, f32)) -> Result<Vec<u8>, OutOfMemory> {
+        let mut out = try_with_capacity(self.samples.len() * 3, "the image's bytes")?;
+        self.rgb8_into(view, depth, &mut out);
+        Ok(out)
+    }
+
+    fn rgb8_into(&self, view: View, depth: (f32, f32), out: &mut Vec<u8>) {
         for s in &self.samples {
             match view {
                 View::Color => out.extend_from_slice(&s.color),
@@ -90,7 +122,6 @@ impl Frame {
                 }
             }
         }
-        out
     }
 
     /// RGBA8 bytes (opaque) of one view, for textures.

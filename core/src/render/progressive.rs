@@ -58,6 +58,13 @@ impl SharedFrame {
     pub fn new() -> Self {
         Self::default()
     }
+    /// A `width` × `height` frame allocated now, fallibly: a render of that size into it
+    /// allocates no frame of its own.
+    pub fn try_sized(width: u32, height: u32) -> Result<Self, crate::memory::OutOfMemory> {
+        let shared = Self::new();
+        *shared.lock() = Frame::try_new(width, height)?;
+        Ok(shared)
+    }
     /// The frame as it is now. Hold the guard briefly: the renderer waits for it.
     pub fn lock(&self) -> MutexGuard<'_, Frame> {
         self.frame.lock().unwrap_or_else(PoisonError::into_inner)
@@ -285,6 +292,18 @@ pub fn render_coarse(
 /// Renders the full-resolution image in one pass.
 pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
     render_frame_traced(scene, settings, Tracing::default())
+}
+
+/// [`render_frame`], with an error instead of an abort where the frame does not fit in
+/// memory.
+pub fn try_render_frame(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+) -> Result<Frame, crate::memory::OutOfMemory> {
+    let target = SharedFrame::try_sized(settings.width, settings.height)?;
+    let never = AtomicBool::new(false);
+    let _ = render_full(scene, settings, &target, &never);
+    Ok(std::mem::replace(&mut *target.lock(), Frame::new(0, 0)))
 }
 
 /// [`render_frame`] with the primary rays traced as `tracing` says.

@@ -182,6 +182,19 @@ impl Graph {
         id
     }
 
+    /// [`Graph::add`], or an error where the arena cannot grow (a scene of millions of
+    /// objects under a memory limit).
+    pub fn try_add(&mut self, node: Node) -> Result<NodeId, crate::memory::OutOfMemory> {
+        let more = self.nodes.len().max(1);
+        crate::memory::fallibly(|| self.nodes.try_reserve(1)).map_err(|_| {
+            crate::memory::OutOfMemory {
+                what: "the scene's objects",
+                bytes: (more * std::mem::size_of::<Node>()) as u64,
+            }
+        })?;
+        Ok(self.add(node))
+    }
+
     pub fn push_child(&mut self, parent: NodeId, child: NodeId) {
         self.nodes[parent.index()].children.push(child);
     }

@@ -535,8 +535,15 @@ pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
                 continue;
             }
         }
+        // Only what can hold a Transform: a million spheres in a Group are not a million
+        // copies of its matrix on the stack.
         for &c in node.children.iter().rev() {
-            stack.push((c, world));
+            if graph
+                .get(c)
+                .is_some_and(|n| matches!(n.kind, NodeKind::Transform(_)) || !n.children.is_empty())
+            {
+                stack.push((c, world));
+            }
         }
     }
     out
