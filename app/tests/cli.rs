@@ -293,6 +293,41 @@ fn fmt_keeps_comments() {
     }
 }
 
+/// `fmt` read a 3.6 MB scene of Groups nested 180,000 deep and wrote its canonical form,
+/// over 64 MiB (every level a line, indented), which tracelab then refused to open. It
+/// refuses instead, saying why, and writes nothing; a shallower one still goes through.
+#[test]
+fn fmt_refuses_to_write_what_it_could_not_read_back() {
+    let d = temp_dir("fmt-too-deep");
+    let nested = |depth: usize| {
+        let mut s = String::from(
+            "OrthographicCamera{center 0 0 10 direction 0 0 -1 up 0 1 0 size 5}\n\
+             Materials{numMaterials 1 Material{diffuseColor 1 0 0}}\n",
+        );
+        s.push_str(&"Group{numObjects 1\n".repeat(depth));
+        s.push_str("Sphere{center 0 0 0 radius 1}");
+        s.push_str(&"}".repeat(depth));
+        s
+    };
+    std::fs::write(d.join("deep.txt"), nested(180_000)).expect("write");
+    let o = tracelab(&["fmt", "deep.txt", "-o", "out.txt"], &d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("deep.txt: not rewritten: its text would be ")
+            && stderr(&o).contains("MiB, more than the 64 MiB tracelab reads as a scene"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!d.join("out.txt").exists());
+    let o = tracelab(&["fmt", "deep.txt"], &d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(o.stdout.is_empty());
+    std::fs::write(d.join("less.txt"), nested(1000)).expect("write");
+    let o = tracelab(&["fmt", "less.txt", "-o", "out.txt"], &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 // ---- Robustness (issue 11): sizes, non-UTF-8 arguments, pipes, full devices, writes ----
 
 /// A private device node (never the machine's own /dev files); `None`, with a message,

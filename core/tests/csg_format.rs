@@ -259,6 +259,41 @@ fn box_errors_have_locations() {
     assert_eq!(e, ["4:26: expected 3 numbers after \"max\", found \"}\""]);
 }
 
+/// A flat box (min = max on an axis) used to be accepted and render as nothing: no ray
+/// enters a slab of width zero. It is refused where it stands, by the one rule set (so the
+/// editor refuses the same edit, and the writer will not write one).
+#[test]
+fn a_flat_box_is_refused_with_its_location() {
+    let e = errors("Group {\n numObjects 1\n MaterialIndex 0\n Box { min 0 2 0 max 1 2 1 }\n}\n");
+    assert_eq!(
+        e,
+        [
+            "4:2: Box: min and max are equal on y (2), so the box is flat and would not be seen; give it a thickness"
+        ]
+    );
+    let e = errors("Group {\n numObjects 1\n MaterialIndex 0\n Box { min 0 0 0 max 0 0 0 }\n}\n");
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert!(
+        e[0].starts_with("4:2: Box: min and max are equal on x (0)"),
+        "{e:?}"
+    );
+    // The checked writer (the editor's Save) refuses a box flattened after parsing.
+    let mut scene = parse_ok(&format!(
+        "{HEAD}Group {{ numObjects 1 MaterialIndex 0 Box {{ min 0 0 0 max 1 1 1 }} }}\n"
+    ));
+    let id = scene
+        .graph
+        .iter()
+        .find(|(_, n)| matches!(n.kind, NodeKind::Box { .. }))
+        .map(|(id, _)| id)
+        .expect("a box");
+    if let Some(NodeKind::Box { max, .. }) = scene.graph.get_mut(id).map(|n| &mut n.kind) {
+        max.z = 0.0;
+    }
+    let problems = tracelab_core::try_write_scene(&scene).expect_err("a flat box");
+    assert!(problems[0].message.contains("equal on z"), "{problems:?}");
+}
+
 #[test]
 fn unknown_keyword_and_unterminated_csg_are_reported() {
     let e = errors(

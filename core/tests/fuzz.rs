@@ -218,6 +218,7 @@ const SCENE_WORDS: &[&str] = &[
     "angle",
     "size",
     "é",
+    "\u{feff}",
     "cube.obj",
     "../assets/cube.obj",
     "no_such.obj",
@@ -368,12 +369,28 @@ const OBJ_WORDS: &[&str] = &[
     "\r\n",
     "v",
     "f",
+    // A byte-order mark (skipped at the start) and comments after a value (refused, located).
+    "\u{feff}",
+    " # c",
+    "\nv 1 2 3 # c",
+    "\nv 1 2 3 1 0",
+    "1e39",
 ];
 
 /// Both readers on one OBJ text: never a panic; when the fast one accepts, tobj reads the
 /// same triangles.
 fn obj_case(input: &[u8]) -> Result<(), String> {
-    let _ = parse_obj(input, "fuzz.obj");
+    // Every refusal of the text names its line: `fuzz.obj:LINE: what is wrong`.
+    if let Err(e) = parse_obj(input, "fuzz.obj") {
+        let e = e.to_string();
+        let line = e
+            .strip_prefix("fuzz.obj:")
+            .and_then(|r| r.split_once(": "))
+            .map(|(n, _)| n);
+        if !line.is_some_and(|n| n.parse::<u32>().is_ok_and(|n| n > 0)) {
+            return Err(format!("a refusal without a line: {e}"));
+        }
+    }
     let Some((fp, ft)) = parse_obj_fast(input) else {
         return Ok(());
     };

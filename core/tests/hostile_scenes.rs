@@ -113,6 +113,31 @@ fn errors(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// A UTF-8 byte-order mark at the start (Notepad's "UTF-8 with BOM") used to make the first
+/// word "\u{feff}OrthographicCamera", refused as an unknown keyword whose odd character is
+/// invisible. It is skipped; the scene reads as without it, positions included.
+#[test]
+fn a_byte_order_mark_at_the_start_is_skipped() {
+    let text = format!(
+        "{HEAD}Group {{ numObjects 1 MaterialIndex 0 Sphere {{ center 0 0 0 radius 1 }} }}\n"
+    );
+    let plain = parse(&text);
+    let marked = parse(&format!("\u{feff}{text}"));
+    assert!(!marked.diagnostics.has_errors(), "{}", marked.diagnostics);
+    assert_eq!(marked.scene, plain.scene);
+    // Errors after it keep their lines.
+    let e = errors(&format!(
+        "\u{feff}{HEAD}Group {{ numObjects 1 Sphere {{ }} }}\n"
+    ));
+    assert!(e[0].starts_with("3:"), "{e:?}");
+    // Anywhere else it is a character of the word, and the message shows it by name.
+    let e = errors(&format!("{HEAD}\u{feff}Group {{ numObjects 0 }}\n"));
+    assert!(
+        e[0].starts_with("3:1: unknown keyword \"\\u{feff}Group\""),
+        "{e:?}"
+    );
+}
+
 #[test]
 fn control_bytes_from_the_input_are_escaped_in_messages() {
     let out = parse(&format!(

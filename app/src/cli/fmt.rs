@@ -38,6 +38,10 @@ pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()>
         }
     }
     let text = tracelab_core::write_scene(&s);
+    // Deep nesting makes the canonical text longer than its source: refuse what could not
+    // be opened again, rather than write it.
+    tracelab_core::format::check_reads_back(&text)
+        .map_err(|e| anyhow::anyhow!("{}: not rewritten: {e}", scene.display()))?;
     match output {
         None => write_stdout(text.as_bytes()),
         Some(out) => crate::io::write_atomic(out, text.as_bytes())

@@ -17,6 +17,13 @@ pub enum SaveError {
     /// A node is incomplete or a rule is broken: what to fix, one line each.
     #[error("{}: not saved; first fix:\n{}", .path.display(), .fix.iter().map(|f| format!("  {f}")).collect::<Vec<_>>().join("\n"))]
     BreaksRules { path: PathBuf, fix: Vec<String> },
+    /// The text would be longer than a scene file tracelab reads (deep nesting): written,
+    /// it could not be opened again.
+    #[error("{}: not saved: {source}", .path.display())]
+    TooLarge {
+        path: PathBuf,
+        source: tracelab_core::format::TooLargeToReadBack,
+    },
     /// The checked text would not read back as this document: a writer or parser bug.
     #[error("{}: not saved, because {why} (a tracelab bug; please report it)", .path.display())]
     WouldNotReadBack { path: PathBuf, why: String },

@@ -393,6 +393,10 @@ impl Document {
                 path: path.to_path_buf(),
                 fix: problems.into_iter().map(|p| p.message).collect(),
             })?;
+        tracelab_core::format::check_reads_back(&text).map_err(|source| SaveError::TooLarge {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let back = tracelab_core::parse_scene_unresolved(text.as_bytes(), &name);
         let why = match back.scene {
             // Node errors (an OBJ that does not load) open too, as they did here.
@@ -493,6 +497,33 @@ mod tests {
             obj_file(&doc.scene).as_deref(),
             Some("../../scenes/mesh.obj")
         );
+    }
+
+    /// Save wrote canonical text of any length; a scene nested 180,000 deep gives 74 MB,
+    /// more than the 64 MiB tracelab reads, so the saved file could not be opened again.
+    #[test]
+    fn save_refuses_text_longer_than_a_scene_file_tracelab_reads() {
+        let d = temp_dir("too-large");
+        let depth = 180_000;
+        let text = format!(
+            "OrthographicCamera{{center 0 0 10 direction 0 0 -1 up 0 1 0 size 5}}\n\
+             Materials{{numMaterials 1 Material{{diffuseColor 1 0 0}}}}\n{}Sphere{{center 0 0 0 radius 1}}{}",
+            "Group{numObjects 1\n".repeat(depth),
+            "}".repeat(depth)
+        );
+        std::fs::write(d.join("scenes/deep.txt"), text).expect("scene");
+        let mut doc = Document::new(Scene::default(), None);
+        doc.open(&d.join("scenes/deep.txt")).expect("opens");
+        let out = d.join("out/deep.txt");
+        let e = doc.save_as(&out).expect_err("too large to read back");
+        assert!(matches!(e, SaveError::TooLarge { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .contains("MiB, more than the 64 MiB tracelab reads as a scene"),
+            "{e}"
+        );
+        assert!(!out.exists());
+        let _ = std::fs::remove_dir_all(&d);
     }
 
     #[test]

@@ -21,13 +21,15 @@ pub struct Diagnostic {
     pub message: String,
 }
 
-/// Text from a file or a path made safe to print: control characters (ESC, vertical tab, …)
-/// and bidirectional overrides are written as escapes, so a message cannot drive the terminal
-/// or reorder what it shows.
+/// Text from a file or a path made safe to print: control characters (ESC, vertical tab, …),
+/// bidirectional overrides and invisible characters (a byte-order mark, zero-width spaces)
+/// are written as escapes, so a message cannot drive the terminal, reorder what it shows, or
+/// quote a word whose fault cannot be seen.
 pub fn escape_controls(s: &str) -> Cow<'_, str> {
     let unsafe_char = |c: char| {
         c.is_control()
             || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+            || matches!(c, '\u{feff}' | '\u{200b}'..='\u{200d}' | '\u{2060}'..='\u{2064}')
     };
     if !s.chars().any(unsafe_char) {
         return Cow::Borrowed(s);
@@ -198,6 +200,11 @@ mod tests {
         assert_eq!(
             escape_controls("a\u{1b}[31mb\u{b}c\u{7f}\u{202e}d\u{85}"),
             "a\\x1b[31mb\\x0bc\\x7f\\u{202e}d\\u{85}"
+        );
+        // Invisible characters too: a BOM inside a file, zero-width spaces.
+        assert_eq!(
+            escape_controls("\u{feff}Group Sph\u{200b}ere"),
+            "\\u{feff}Group Sph\\u{200b}ere"
         );
         // Escaping twice changes nothing more.
         let once = escape_controls("\u{1b}x").into_owned();

@@ -19,4 +19,6 @@ pub use parser::{
 };
 pub use rebase::rebase_mesh_paths;
 pub use resolve::resolve_meshes;
-pub use writer::{try_write_scene, uses_only_course_grammar, write_scene};
+pub use writer::{
+    TooLargeToReadBack, check_reads_back, try_write_scene, uses_only_course_grammar, write_scene,
+};

@@ -5,6 +5,7 @@
 mod error;
 mod fast;
 mod file_kind;
+mod locate;
 
 pub use error::{MESH_LOAD_CANCELLED, ObjError};
 
@@ -186,25 +187,35 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, ObjError> {
 
 /// Positions and triangles of OBJ text, checked, before the BVH is built.
 fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
+    let bytes = without_bom(bytes);
     let (positions, triangles) = match fast::parse(bytes) {
         Some(r) => r,
         None => load_with_tobj(bytes, name)?,
     };
-    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(ObjError::Syntax(format!("vertex {} is not finite", i + 1)));
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(ObjError::Syntax(locate::non_finite_vertex(bytes, name)));
     }
     Ok((positions, triangles))
 }
 
+/// The text after a UTF-8 byte-order mark, which some editors on Windows put first. Read
+/// as text it would make the first line's keyword "\u{feff}v", which both readers skip as
+/// unknown: the first vertex lost and every face shifted by one.
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
+}
+
 /// Positions and triangles as the fast reader gives them, or None when it defers to tobj.
 pub fn parse_obj_fast(bytes: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
-    fast::parse(bytes)
+    fast::parse(without_bom(bytes))
 }
 
 /// The reference reader: every OBJ feature tobj knows, all objects and groups merged.
 /// `mtllib` files are never opened: tracelab shades with the scene's materials, and a
-/// material library could be a FIFO or a device.
+/// material library could be a FIFO or a device. Its errors are told as
+/// `name:LINE: what is wrong`, found by reading the text again with tobj's rules.
 pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
+    let bytes = without_bom(bytes);
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -212,14 +223,13 @@ pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 
         ignore_lines: true,
     };
     let no_materials = |_: &Path| -> tobj::MTLLoadResult { Err(tobj::LoadError::OpenFileFailed) };
-    let (models, _materials) = match tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials) {
-        Ok(r) => r,
-        Err(e) => {
-            return Err(ObjError::Syntax(
-                locate_obj_error(bytes, name).unwrap_or_else(|| e.to_string()),
-            ));
-        }
+    let refused = |e: &tobj::LoadError| {
+        ObjError::Syntax(
+            locate::tobj_refusal(bytes, name).unwrap_or_else(|| locate::unlocated(e, name)),
+        )
     };
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials).map_err(|e| refused(&e))?;
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     for m in &models {
@@ -234,75 +244,12 @@ pub fn load_with_tobj(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 
         for t in m.mesh.indices.chunks_exact(3) {
             let tri = [t[0] + base, t[1] + base, t[2] + base];
             if tri.iter().any(|&i| i >= nv) {
-                return Err(ObjError::Syntax(
-                    locate_obj_error(bytes, name)
-                        .unwrap_or_else(|| "a face refers to a vertex that does not exist".into()),
-                ));
+                return Err(refused(&tobj::LoadError::FaceVertexOutOfBounds));
             }
             triangles.push(tri);
         }
     }
     Ok((positions, triangles))
-}
-
-/// tobj's errors carry no line; find the first line that is wrong, to say where.
-fn locate_obj_error(bytes: &[u8], name: &str) -> Option<String> {
-    let text = match std::str::from_utf8(bytes) {
-        Ok(t) => t,
-        Err(e) => {
-            let line = bytes[..e.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
-            return Some(format!("{name}:{line}: not a text OBJ file"));
-        }
-    };
-    let mut nv: i64 = 0;
-    for (ln, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let at = |msg: String| Some(format!("{name}:{}: {msg}", ln + 1));
-        match words.next() {
-            Some("v") => {
-                let coords: Vec<&str> = words.collect();
-                if coords.len() < 3
-                    || coords
-                        .iter()
-                        .take(3)
-                        .any(|c| c.parse::<f32>().map_or(true, |v| !v.is_finite()))
-                {
-                    return at(format!(
-                        "bad vertex \"{}\": expected three numbers",
-                        line.trim()
-                    ));
-                }
-                nv += 1;
-            }
-            Some("f") => {
-                let verts: Vec<&str> = words.collect();
-                if verts.len() < 3 {
-                    return at(format!(
-                        "face \"{}\" has fewer than three vertices",
-                        line.trim()
-                    ));
-                }
-                for v in verts {
-                    let idx = v.split('/').next().unwrap_or("");
-                    match idx.parse::<i64>() {
-                        Ok(i) if (i > 0 && i <= nv) || (i < 0 && -i <= nv) => {}
-                        Ok(i) => {
-                            return at(format!(
-                                "face refers to vertex {i}, but only {nv} vertices come before it"
-                            ));
-                        }
-                        Err(_) => return at(format!("bad face index \"{v}\"")),
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    None
 }
 
 #[cfg(test)]
@@ -422,6 +369,117 @@ mod tests {
         // The dragon takes tobj seconds in a debug build; the smaller meshes cover the format.
         for name in ["cube.obj", "bunny_1k.obj", "stanford-bunny.obj"] {
             same_geometry(&dir.join(name));
+        }
+    }
+
+    /// A UTF-8 byte-order mark before the first `v` used to hide that vertex (the line's
+    /// keyword read as "\u{feff}v"), shifting every face by one, exit 0. Both readers skip it.
+    #[test]
+    fn a_byte_order_mark_is_skipped_by_both_readers() {
+        let plain = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 2 3 4\n";
+        let with_bom = format!("\u{feff}{plain}");
+        let want = parse_obj_triangles(plain.as_bytes(), "m.obj").expect("plain");
+        assert_eq!(
+            parse_obj_triangles(with_bom.as_bytes(), "m.obj").expect("with a BOM"),
+            want
+        );
+        assert_eq!(parse_obj_fast(with_bom.as_bytes()), Some(want.clone()));
+        // tobj's result as positions per triangle (it renumbers the vertices it uses).
+        let corners = |(p, t): (Vec<Vec3>, Vec<[u32; 3]>)| -> Vec<[Vec3; 3]> {
+            t.iter().map(|tri| tri.map(|i| p[i as usize])).collect()
+        };
+        assert_eq!(
+            corners(load_with_tobj(with_bom.as_bytes(), "m.obj").expect("tobj")),
+            corners(want)
+        );
+        // A file only tobj reads (relative indices), with a BOM.
+        let relative = "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n";
+        let (p, t) = parse_obj_triangles(relative.as_bytes(), "m.obj").expect("tobj, BOM");
+        assert_eq!(t.len(), 1);
+        assert_eq!(t[0].map(|i| p[i as usize]), [Vec3::ZERO, Vec3::X, Vec3::Y]);
+    }
+
+    /// Every refusal is `m.obj:LINE: what is wrong` in tracelab's words, never tobj's
+    /// ("color parse error" for a comment after a vertex, "face vertex out of bounds").
+    #[test]
+    fn every_refusal_names_its_line_in_our_words() {
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        for (text, want) in [
+            (
+                format!("v 0 0 0 # origin\n{tri}f 1 2 3\n"),
+                "m.obj:1: vertex \"v 0 0 0 # origin\" has 5 values: expected x y z, x y z w or x y z r g b (a # comment must be on a line of its own)",
+            ),
+            (
+                format!("{tri}v 0 0\nf 1 2 3\n"),
+                "m.obj:4: bad vertex \"v 0 0\": expected three numbers",
+            ),
+            (
+                format!("{tri}v 0 0 0 0\nf 1 2 3\n"),
+                "m.obj:4: vertex \"v 0 0 0 0\" has w = 0",
+            ),
+            (
+                format!("{tri}vt 0\nf 1 2 3\n"),
+                "m.obj:4: bad texture coordinate \"vt 0\": expected two numbers",
+            ),
+            (
+                format!("{tri}vn 0 0 x\nf 1 2 3\n"),
+                "m.obj:4: bad normal \"vn 0 0 x\": expected three numbers",
+            ),
+            (format!("{tri}f 1 2 x\n"), "m.obj:4: bad face index \"x\""),
+            (
+                format!("{tri}f 1 2 3/1/1/1\n"),
+                "m.obj:4: bad face index \"3/1/1/1\": at most vertex/texture/normal",
+            ),
+            (format!("{tri}f\n"), "m.obj:4: face without vertices"),
+            (
+                format!("{tri}usemtl\nf 1 2 3\n"),
+                "m.obj:4: usemtl without a material name",
+            ),
+            (
+                format!("{tri}f 1 2 3\nf 1 2 4\ng next\nv 0 0 1\n"),
+                "m.obj:5: face refers to vertex 4, but the file has only 3 vertices",
+            ),
+            (
+                format!("{tri}f -1 -2 -4\n"),
+                "m.obj:4: face refers to vertex -4, counting back past the first of the 3 vertices before it",
+            ),
+            (
+                format!("{tri}f 0 1 2\n"),
+                "m.obj:4: face refers to vertex \"0\": vertex indices start at 1",
+            ),
+            (
+                format!("{tri}vt 0 0\nf 1/1 2/2 3/1\n"),
+                "m.obj:5: face \"2/2\" refers to a texture coordinate that does not exist (the file has 1)",
+            ),
+            (
+                format!("{tri}vn 0 0 1\nf 1//1 2//1 3//3\n"),
+                "m.obj:5: face \"3//3\" refers to a normal that does not exist (the file has 1)",
+            ),
+            (
+                "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_string(),
+                "m.obj:4: face uses vertex 2, which has no colour while others have: give every vertex r g b, or none",
+            ),
+            (
+                format!("{tri}f 1 2 3\n\u{ff}\n"),
+                "m.obj:5: not a text OBJ file: bytes that are not UTF-8",
+            ),
+            (
+                "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_string(),
+                "m.obj:1: vertex \"v 1e39 0 0\" is not a finite number (f32 holds up to about 3.4e38)",
+            ),
+            (
+                format!("{tri}v 1 1 1 1e-39\nf 1 2 4\n"),
+                "m.obj:4: vertex \"v 1 1 1 1e-39\" is not a finite number (f32 holds up to about 3.4e38)",
+            ),
+        ] {
+            // The \u{ff} case is bytes, not text.
+            let bytes = text.replace('\u{ff}', "\u{1}").into_bytes();
+            let bytes: Vec<u8> = bytes
+                .iter()
+                .map(|&b| if b == 1 { 0xff } else { b })
+                .collect();
+            let e = parse_obj(&bytes, "m.obj").expect_err(&text);
+            assert_eq!(e.to_string(), want, "{text:?}");
         }
     }
 

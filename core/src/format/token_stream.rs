@@ -29,9 +29,15 @@ struct State {
 
 impl<'a> TokenStream<'a> {
     pub fn new(text: &'a str) -> Self {
+        // A UTF-8 byte-order mark (some Windows editors write one) is not part of the first
+        // word: skipped, as whitespace is.
+        let start = if text.starts_with('\u{feff}') { 3 } else { 0 };
         TokenStream {
             text,
-            state: RefCell::new(State::default()),
+            state: RefCell::new(State {
+                next_chunk: start,
+                ..State::default()
+            }),
         }
     }
 

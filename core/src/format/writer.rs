@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 
 use glam::Vec3;
 
+use super::MAX_SCENE_BYTES;
 use crate::scene::{
     Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Problem, Scene,
     TransformOp, check_scene,
@@ -73,6 +74,29 @@ impl<'a> Inner<'a> {
             comment_lines(out, ind, lines);
         }
         comment_lines(out, ind, end);
+    }
+}
+
+/// Scene text longer than the reader takes ([`MAX_SCENE_BYTES`]): written, it could not be
+/// opened again. Deep nesting makes the canonical text larger than the file it came from
+/// (each level is a line of its own, indented up to `MAX_INDENT_DEPTH`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "its text would be {} MiB, more than the {} MiB tracelab reads as a scene, so it could not be opened again",
+    .bytes.div_ceil(1 << 20),
+    MAX_SCENE_BYTES >> 20
+)]
+pub struct TooLargeToReadBack {
+    pub bytes: usize,
+}
+
+/// Whether scene text is short enough to be read back: what every writer of a scene file
+/// checks before writing.
+pub fn check_reads_back(text: &str) -> Result<(), TooLargeToReadBack> {
+    if text.len() > MAX_SCENE_BYTES {
+        Err(TooLargeToReadBack { bytes: text.len() })
+    } else {
+        Ok(())
     }
 }
 

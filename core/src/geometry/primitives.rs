@@ -101,7 +101,7 @@ pub fn intersect_triangle(
     t_min: f32,
     t_max: f32,
 ) -> Option<(f32, f32, f32)> {
-    let (t, u, v) = moller_trumbore::<true>(ray.origin, ray.direction, a, b - a, c - a)?;
+    let (t, u, v) = moller_trumbore(ray.origin, ray.direction, a, b - a, c - a)?;
     (t > t_min && t < t_max).then_some((t, u, v))
 }
 
@@ -109,11 +109,11 @@ pub fn intersect_triangle(
 /// `o + t d` crosses it, t not range-checked. The one scalar copy of the test: the mesh BVH's
 /// AVX leaf repeats these operations lane by lane, so every path gives the same t bit for bit.
 ///
-/// `REJECT_INFINITE_DET` also misses when the determinant overflows (its reciprocal would
-/// be 0, and t ±0 or NaN). `intersect_triangle` sets it; the mesh BVH does not, because its
-/// AVX leaf has no such test and the two must agree; with t_min >= 0 the results are the same.
+/// When the determinant overflows f32 (edges of ~1.8e19 and more seen by a unit ray) the
+/// test is done again in f64, which holds every product of f32 numbers: the triangle is
+/// still found where its edges are f32 numbers. The AVX leaf sends those lanes here too.
 #[inline(always)]
-pub(crate) fn moller_trumbore<const REJECT_INFINITE_DET: bool>(
+pub(crate) fn moller_trumbore(
     o: Vec3,
     d: Vec3,
     v0: Vec3,
@@ -122,8 +122,11 @@ pub(crate) fn moller_trumbore<const REJECT_INFINITE_DET: bool>(
 ) -> Option<(f32, f32, f32)> {
     let p = d.cross(e2);
     let det = e1.dot(p);
-    if det == 0.0 || (REJECT_INFINITE_DET && !det.is_finite()) {
+    if det == 0.0 {
         return None;
+    }
+    if !det.is_finite() {
+        return moller_trumbore_f64(o, d, v0, e1, e2);
     }
     let inv_det = 1.0 / det;
     let s = o - v0;
@@ -139,9 +142,67 @@ pub(crate) fn moller_trumbore<const REJECT_INFINITE_DET: bool>(
     Some((e2.dot(q) * inv_det, u, v))
 }
 
+/// `moller_trumbore` in f64, for the triangles whose determinant overflows f32. A t past
+/// f32's range comes back infinite, and so out of any range tested.
+#[cold]
+#[inline(never)]
+pub(crate) fn moller_trumbore_f64(
+    o: Vec3,
+    d: Vec3,
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+) -> Option<(f32, f32, f32)> {
+    let (o, d, v0, e1, e2) = (
+        o.as_dvec3(),
+        d.as_dvec3(),
+        v0.as_dvec3(),
+        e1.as_dvec3(),
+        e2.as_dvec3(),
+    );
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    // Infinite or NaN only when an edge is: an edge past f32::MAX was never a number here.
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let s = o - v0;
+    let u = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv_det;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(((e2.dot(q) * inv_det) as f32, u as f32, v as f32))
+}
+
 /// The face normal (b − a) × (c − a), normalised: counter-clockwise vertices face the viewer.
+/// In f32 where that is exact enough (every triangle of ordinary size, so renders stay what
+/// they were); where f32 fails (edges past ~4e9 overflow the squared length, past ~1.8e19 the
+/// cross product, past f32::MAX the edges themselves; tiny triangles underflow) in f64,
+/// whose range holds every product of f32 coordinates. Zero only for a degenerate triangle.
+#[inline]
 pub fn triangle_normal(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
-    (b - a).cross(c - a).normalize_or_zero()
+    let n = (b - a).cross(c - a);
+    // `normalize_or_zero`'s own test: 1/|n| finite and positive.
+    let rcp = n.length_recip();
+    if rcp.is_finite() && rcp > 0.0 {
+        n * rcp
+    } else {
+        triangle_normal_f64(a, b, c)
+    }
+}
+
+/// `triangle_normal` for the triangles f32 cannot take. The packet shader calls it for the
+/// same lanes, so both paths give the same bits.
+#[cold]
+pub(crate) fn triangle_normal_f64(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+    (b - a).cross(c - a).normalize_or_zero().as_vec3()
 }
 
 /// A box face: axis · 2 + 1 for the max side. Its outward normal is `box_face_normal`.
@@ -275,6 +336,56 @@ mod tests {
         let r = Ray::new(Vec3::new(0.25, 0.25, -3.0), Vec3::Z);
         assert!(intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).is_some());
         assert_eq!(triangle_normal(a, b, c), Vec3::Z);
+    }
+
+    /// Edges of 1e10 overflow the f32 squared length, 1e19 the cross product, 3e38 (corners
+    /// at ±3e38) the edges themselves: the normal is still the plane's, in every case and
+    /// both windings; tiny triangles whose squared length underflows too.
+    #[test]
+    fn triangle_normals_survive_any_f32_size() {
+        for s in [1e10f32, 1e19, 3e38, 1e-20] {
+            let (a, b, c) = (
+                Vec3::new(-s, -s, 0.0),
+                Vec3::new(s, -s, 0.0),
+                Vec3::new(0.0, s, 0.0),
+            );
+            assert_eq!(triangle_normal(a, b, c), Vec3::Z, "{s:e}");
+            assert_eq!(triangle_normal(a, c, b), Vec3::NEG_Z, "{s:e}");
+            let tilted = triangle_normal(a, b, Vec3::new(0.0, s, s));
+            assert!(
+                (tilted - Vec3::new(0.0, -1.0, 2.0).normalize()).length() < 1e-6,
+                "{s:e}"
+            );
+        }
+        // Ordinary triangles keep their f32 normal bit for bit.
+        let (a, b, c) = (Vec3::new(0.1, 0.2, 0.3), Vec3::new(1.7, -0.4, 2.0), Vec3::Y);
+        assert_eq!(triangle_normal(a, b, c), (b - a).cross(c - a).normalize());
+        assert_eq!(
+            triangle_normal(Vec3::ZERO, Vec3::X, Vec3::X * 2.0),
+            Vec3::ZERO
+        );
+    }
+
+    /// A determinant that overflows f32 (edges of 1e19 and up) is redone in f64: the hit is
+    /// found at the right t; edges past f32::MAX cannot be, as b − a is no f32 number.
+    #[test]
+    fn huge_triangles_are_hit_where_their_edges_are_f32_numbers() {
+        let r = Ray::new(Vec3::new(0.25, 0.25, 3.0), Vec3::NEG_Z);
+        for s in [1e10f32, 1e19, 1.5e38] {
+            let (a, b, c) = (
+                Vec3::new(-s, -s, 0.0),
+                Vec3::new(s, -s, 0.0),
+                Vec3::new(0.0, s, 0.0),
+            );
+            let hit = intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY);
+            assert_eq!(hit.map(|h| h.0), Some(3.0), "{s:e}");
+        }
+        let (a, b, c) = (
+            Vec3::new(-3e38, -3e38, 0.0),
+            Vec3::new(3e38, -3e38, 0.0),
+            Vec3::new(0.0, 3e38, 0.0),
+        );
+        assert!(intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).is_none());
     }
 
     #[test]

@@ -50,12 +50,19 @@ pub fn quantize(c: f32) -> u8 {
 }
 
 /// Depth view shade: (max − t)/(max − min) clamped to [0, 1]; t < min is white, t > max black.
+/// In f32 where both differences are f32 numbers (so ordinary ranges shade as they always
+/// have), else in f64, where they cannot overflow: `--depth -3e38 3e38` is a gradient too.
 #[inline]
 pub fn depth_shade(t: f32, min: f32, max: f32) -> f32 {
     if max == min {
         return if t <= min { 1.0 } else { 0.0 };
     }
-    ((max - t) / (max - min)).clamp(0.0, 1.0)
+    let (num, den) = (max - t, max - min);
+    if num.is_finite() && den.is_finite() {
+        return (num / den).clamp(0.0, 1.0);
+    }
+    let (t, min, max) = (f64::from(t), f64::from(min), f64::from(max));
+    (((max - t) / (max - min)).clamp(0.0, 1.0)) as f32
 }
 
 impl Frame {
@@ -221,6 +228,29 @@ mod tests {
                 [quantize(v.x), quantize(v.y), quantize(v.z)],
                 "{v:?}"
             );
+        }
+    }
+
+    /// A range whose width overflows f32 (`--depth 3e38 -3e38`, or -3e38 3e38) still maps
+    /// depth to a gradient (it was black everywhere: (max − min) was ±inf), and ranges whose
+    /// differences are f32 numbers keep their f32 quotient bit for bit.
+    #[test]
+    fn depth_ranges_wider_than_f32_still_shade() {
+        assert_eq!(depth_shade(0.0, 3e38, -3e38), 0.5);
+        assert_eq!(depth_shade(0.0, -3e38, 3e38), 0.5);
+        assert_eq!(depth_shade(-3e38, -3e38, 3e38), 1.0);
+        assert_eq!(depth_shade(3e38, -3e38, 3e38), 0.0);
+        let near = depth_shade(1.5e38, -3e38, 3e38);
+        assert!((near - 0.25).abs() < 1e-6, "{near}");
+        // t itself so far off that max − t overflows.
+        assert_eq!(depth_shade(-3e38, 0.0, 3e38), 1.0);
+        for (t, min, max) in [
+            (9.5f32, 8.0f32, 12.0f32),
+            (3.3, 1.0, 7.7),
+            (1e20, -1e20, 3e20),
+        ] {
+            let f32_quotient = ((max - t) / (max - min)).clamp(0.0, 1.0);
+            assert_eq!(depth_shade(t, min, max).to_bits(), f32_quotient.to_bits());
         }
     }
 }

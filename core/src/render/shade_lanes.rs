@@ -14,7 +14,7 @@ use glam::Vec3;
 use super::compile::{CompiledScene, Hit, Shape};
 use super::shade::shade_fast;
 use super::{NormalTransform, ObjectRays, RenderSettings};
-use crate::geometry::Ray;
+use crate::geometry::{Ray, triangle_normal};
 
 const N: usize = 8;
 type Lanes = [f32; N];
@@ -206,7 +206,17 @@ fn lanes(input: &Input, ambient: Vec3, lights: &[(Vec3, Vec3)], shade_back: bool
         y: map(|k| e1.z[k] * e2.x[k] - e2.z[k] * e1.x[k]),
         z: map(|k| e1.x[k] * e2.y[k] - e2.x[k] * e1.y[k]),
     };
-    let n_obj = normalize_or(&cross, &V3::default());
+    let mut n_obj = normalize_or(&cross, &V3::default());
+    // Where f32 gave up (zero: overflow, underflow or a degenerate triangle),
+    // `triangle_normal` takes its f64 path: the same call gives the same bits.
+    for k in 0..N {
+        let zero = n_obj.x[k] == 0.0 && n_obj.y[k] == 0.0 && n_obj.z[k] == 0.0;
+        if zero && input.lanes & (1 << k) != 0 {
+            let at = |v: &V3| Vec3::new(v.x[k], v.y[k], v.z[k]);
+            let n = triangle_normal(at(&input.a), at(&input.b), at(&input.c));
+            (n_obj.x[k], n_obj.y[k], n_obj.z[k]) = (n.x, n.y, n.z);
+        }
+    }
     // The normal matrix times n: (x_axis·n.x + y_axis·n.y) + z_axis·n.z, both rules' order
     // (`Mat3::mul_vec3`, and `Mat4::transform_vector3` up to the commuted first sum).
     let m = &input.m;

@@ -400,6 +400,18 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
                     "Box: min must not exceed max on any axis",
                 ));
             }
+            // A flat box has no inside: no ray enters it, so it would render as nothing,
+            // and as a CSG operand it is empty. Refused, to say so.
+            if let Some(axis) = (0..3).find(|&k| min[k] == max[k]) {
+                return Err(Invalid::new(
+                    "max",
+                    format!(
+                        "Box: min and max are equal on {} ({}), so the box is flat and would not be seen; give it a thickness",
+                        ["x", "y", "z"][axis],
+                        min[axis]
+                    ),
+                ));
+            }
         }
     }
     Ok(())

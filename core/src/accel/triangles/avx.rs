@@ -169,6 +169,11 @@ pub(super) fn leaf8<L: LeafRay>(
     let sz = sub(_mm256_set1_ps(o.z), v0z);
     let u = mul(dot(sx, sy, sz, px, py, pz), inv_det);
     let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+    let lanes = (1u32 << count) - 1;
+    // A determinant that overflowed (det − det is NaN): the scalar test redoes those in
+    // f64, so they are taken from it below (rare: edges of ~1.8e19 and more).
+    let overflow = sub(det, det);
+    let slow = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_UNORD_Q>(overflow, overflow)) as u32 & lanes;
     // Ordered compares are false for NaN, as the scalar tests are.
     let ok = _mm256_and_ps(
         _mm256_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
@@ -177,9 +182,8 @@ pub(super) fn leaf8<L: LeafRay>(
             _mm256_cmp_ps::<_CMP_LE_OQ>(u, one),
         ),
     );
-    let lanes = (1u32 << count) - 1;
     // Most leaves a ray enters hold no triangle it crosses: stop before the second half.
-    if _mm256_movemask_ps(ok) as u32 & lanes == 0 {
+    if _mm256_movemask_ps(ok) as u32 & lanes & !slow == 0 && slow == 0 {
         return None;
     }
     let (qx, qy, qz) = cross(sx, sy, sz, e1x, e1y, e1z);
@@ -194,13 +198,27 @@ pub(super) fn leaf8<L: LeafRay>(
         _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(t_min)),
         _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_best)),
     );
-    let mut mask =
-        (_mm256_movemask_ps(_mm256_andnot_ps(reject, _mm256_and_ps(ok, in_range))) as u32) & lanes;
+    let mut mask = (_mm256_movemask_ps(_mm256_andnot_ps(reject, _mm256_and_ps(ok, in_range)))
+        as u32)
+        & lanes
+        & !slow;
+    let mut ts = [0.0f32; WIDTH];
+    store8(&mut ts, t);
+    let mut rest = slow;
+    while rest != 0 {
+        let k = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if let Some(t) = bvh.tri(first + k).hit(o.into(), d.into())
+            && t > t_min
+            && t < t_best
+        {
+            ts[k] = t;
+            mask |= 1 << k;
+        }
+    }
     if mask == 0 {
         return None;
     }
-    let mut ts = [0.0f32; WIDTH];
-    store8(&mut ts, t);
     // Lowest lane first, strictly closer replaces: the scalar loop's choice among equal t.
     let mut best = (f32::INFINITY, usize::MAX);
     while mask != 0 {

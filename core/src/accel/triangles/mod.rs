@@ -63,11 +63,11 @@ struct Tri {
 }
 
 impl Tri {
-    /// The ray parameter of a hit, if any (two-sided, not range-checked). Without the
-    /// infinite-determinant test, as the AVX leaf test, which must agree bit for bit.
+    /// The ray parameter of a hit, if any (two-sided, not range-checked): the triangle
+    /// primitive's test, which the AVX leaf test repeats bit for bit.
     #[inline(always)]
     fn hit(&self, o: Vec3, d: Vec3) -> Option<f32> {
-        moller_trumbore::<false>(o, d, self.v0, self.e1, self.e2).map(|(t, _, _)| t)
+        moller_trumbore(o, d, self.v0, self.e1, self.e2).map(|(t, _, _)| t)
     }
 }
 
