@@ -81,7 +81,11 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     };
     let files = write_frames(&frames, &a.out, &a.stem, a.delay_ms).map_err(anyhow::Error::msg)?;
     if let Some(last) = files.last() {
-        eprintln!("wrote {} frames and {}", frames.len(), last.display());
+        crate::io::write_stderr_text(&format!(
+            "wrote {} frames and {}\n",
+            frames.len(),
+            last.display()
+        ));
     }
     Ok(())
 }

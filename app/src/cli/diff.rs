@@ -16,7 +16,7 @@ use tracelab_core::{CompiledScene, Frame, RenderSettings, Scene, View};
 use super::course::parse_course_args;
 use super::render::{RenderJob, render_with_progress};
 use crate::exit::{Exit, check_size, usage};
-use crate::io::{load_scene, write_atomic, write_stdout};
+use crate::io::{load_scene, write_atomic, write_stdout_text};
 use crate::story::{one_line, pixel_report};
 
 /// `tracelab diff --help`.
@@ -241,7 +241,8 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     if let Some((min, max, d)) = &job.depth {
         all &= check(a, &r, "depth", d, View::Depth, (*min, *max), &mut out)?;
     }
-    write_stdout(out.as_bytes())?;
+    // Paths and node labels (an `obj_file` name) are the user's text: escaped.
+    write_stdout_text(&out)?;
     if all {
         Ok(())
     } else {
