@@ -1,7 +1,7 @@
 //! What the command line prints, as a hostile file or argument meets it: control bytes in
 //! an `obj_file` name, an image path or an argument never reach the terminal raw (in text,
 //! JSON, reports and errors); a closed or full standard output is an error for every
-//! command that writes one.
+//! command that writes one; a mistyped command is a usage error, not the editor.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -112,11 +112,12 @@ fn diff_escapes_the_obj_file_name_in_its_explanations_and_the_image_path() {
 #[test]
 fn errors_escape_the_arguments_they_quote() {
     let d = temp_dir("errors");
-    // Usage errors of tracelab's own (the course's flags) and one of
+    // Usage errors of tracelab's own (the course's flags, a mistyped command) and one of
     // clap's, in colour as on a terminal (clap strips escapes from a pipe, not a terminal).
     for args in [
         &["-input", "s.txt", "-bogus\u{1b}[2J\u{7}"][..],
         &["render", "--size", "x\u{1b}[2J\u{7}", "8"][..],
+        &["rend\u{1b}[2J\u{7}"][..],
     ] {
         let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
             .args(args)
@@ -260,5 +261,28 @@ fn every_command_to_a_null_device_succeeds() {
         // diff: the magenta image does not match (3), and says so on standard output.
         let expected = if args[0] == "diff" { 3 } else { 0 };
         assert_eq!(o.status.code(), Some(expected), "{args:?}: {}", stderr(&o));
+    }
+}
+
+// ---- A mistyped command ----
+
+#[test]
+fn a_mistyped_command_is_a_usage_error_naming_the_nearest_not_the_editor() {
+    let d = temp_dir("mistyped");
+    for (typo, hint) in [
+        ("rendr", "did you mean `render`?"),
+        ("inspcet", "did you mean `inspect`?"),
+        ("zzzqqq", "neither a file nor a command (commands: render,"),
+    ] {
+        // No display: should the editor start anyway, it fails rather than opening a window.
+        let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+            .arg(typo)
+            .current_dir(&d)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("run tracelab");
+        assert_eq!(o.status.code(), Some(2), "{typo}: {}", stderr(&o));
+        assert!(stderr(&o).contains(hint), "{typo}: {}", stderr(&o));
     }
 }

@@ -9,6 +9,7 @@ mod course;
 mod diff;
 mod fmt;
 mod inspect;
+mod mistyped;
 mod render;
 mod values;
 
@@ -24,7 +25,7 @@ pub use course::parse_course_args;
 pub use render::{NormalMode, RenderArgs, RenderJob, run_render};
 
 use crate::bench::{BenchArgs, ProgressiveArgs};
-use crate::exit::Exit;
+use crate::exit::{Exit, usage};
 use crate::io::{write_stderr_text, write_stdout};
 
 #[derive(Parser, Debug)]
@@ -164,7 +165,15 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
                 crate::bench::run_progressive(&b)
             })
         }
-        None => crate::gui::run(cli.scene),
+        None => {
+            let commands = Cli::command();
+            if let Some(m) = cli.scene.as_deref().and_then(|p| {
+                mistyped::mistyped_command(p, commands.get_subcommands().map(|c| c.get_name()))
+            }) {
+                return Err(usage(m));
+            }
+            crate::gui::run(cli.scene)
+        }
     }
 }
 
