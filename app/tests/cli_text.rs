@@ -286,3 +286,30 @@ fn a_mistyped_command_is_a_usage_error_naming_the_nearest_not_the_editor() {
         assert!(stderr(&o).contains(hint), "{typo}: {}", stderr(&o));
     }
 }
+
+// ---- The test-only stall hook ----
+
+/// The hook that lets tests/cli.rs kill a write at the worst moment is compiled only into
+/// debug builds: a release binary with the variable set writes at once and says nothing.
+/// (Runs under `cargo test --release`; debug builds have the hook, which that test uses.)
+#[cfg(not(debug_assertions))]
+#[test]
+fn a_release_binary_ignores_the_stall_hook() {
+    let d = temp_dir("no-stall");
+    let start = std::time::Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args([
+            "fmt",
+            scene().to_str().expect("UTF-8 path"),
+            "-o",
+            "out.txt",
+        ])
+        .current_dir(&d)
+        .env("TRACELAB_TEST_STALL_BEFORE_RENAME", "1")
+        .output()
+        .expect("run tracelab");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("stalled"), "{}", stderr(&o));
+    assert!(start.elapsed() < std::time::Duration::from_secs(30));
+    assert!(d.join("out.txt").is_file());
+}
