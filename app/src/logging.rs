@@ -19,11 +19,13 @@ pub fn init() {
     if on("TRACELAB_LOG_FRAMES") {
         b.filter(Some(FRAMES), log::LevelFilter::Info);
     }
-    // "tracelab: …", as every other message of the program starts.
+    // "tracelab: …", as every other message of the program starts; escaped, since a
+    // message may quote a path.
     b.format(|buf, record| {
         use std::io::Write as _;
         if record.target().starts_with("tracelab") {
-            writeln!(buf, "tracelab: {}", record.args())
+            let text = record.args().to_string();
+            writeln!(buf, "tracelab: {}", crate::io::escape_text(&text))
         } else {
             writeln!(
                 buf,

@@ -801,6 +801,10 @@ fn negative_depth_ranges_are_accepted_in_both_spellings() {
 /// named temporary file would be left behind.
 #[cfg(target_os = "linux")]
 #[test]
+#[cfg_attr(
+    not(debug_assertions),
+    ignore = "the stall hook exists only in debug builds (tests/cli_text.rs checks release ignores it)"
+)]
 fn kill_9_during_fmt_o_leaves_the_old_file_and_no_temporary_file() {
     use std::io::{BufRead, BufReader};
     let d = temp_dir("kill9");

@@ -87,7 +87,11 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     match export(&scene, &sweep, &settings, a.compare, &to, &never, |_| {}) {
         Ok(files) => {
             if let Some(last) = files.last() {
-                eprintln!("wrote {} frames and {}", files.len() - 1, last.display());
+                crate::io::write_stderr_text(&format!(
+                    "wrote {} frames and {}\n",
+                    files.len() - 1,
+                    last.display()
+                ));
             }
             Ok(())
         }

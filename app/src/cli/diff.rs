@@ -16,7 +16,7 @@ use tracelab_core::{CompiledScene, Frame, RenderSettings, Scene, View};
 use super::course::parse_course_args;
 use super::render::{RenderJob, render_with_progress};
 use crate::exit::{Exit, check_size, usage};
-use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout};
+use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout_text};
 use crate::story::{one_line, pixel_report};
 
 /// `tracelab diff --help`.
@@ -377,7 +377,8 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     for s in &students {
         all &= check(a, &r, s, &mut plan, &mut out, &mut failed)?;
     }
-    write_stdout(out.as_bytes())?;
+    // Paths and node labels (an `obj_file` name) are the user's text: escaped.
+    write_stdout_text(&out)?;
     if !failed.is_empty() {
         return Err(Exit::HeatMapNotWritten {
             matched: all,

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use tracelab_core::NodeKind;
 
-use crate::io::{OutputError, OutputPlan, load_scene_text, write_stdout};
+use crate::io::{OutputError, OutputPlan, load_scene_text, write_stderr_text, write_stdout};
 
 /// Warnings (comments that cannot be kept) go to stderr before anything is written. OBJ
 /// files are not opened: the text is all `fmt` rewrites.
@@ -34,7 +34,7 @@ pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()>
                 .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
         };
         for w in tracelab_core::rebase_mesh_paths(&mut s, &dir(scene), &dir(out)) {
-            eprintln!("{}: warning: {w}", out.display());
+            write_stderr_text(&format!("{}: warning: {w}\n", out.display()));
         }
     }
     let text = tracelab_core::write_scene(&s);

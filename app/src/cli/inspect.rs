@@ -8,7 +8,7 @@ use tracelab_core::{CompiledScene, RenderSettings};
 
 use super::render::{NormalMode, ObjectRaysMode};
 use crate::exit::{check_size, usage};
-use crate::io::{load_scene, write_stdout};
+use crate::io::{escape_json, load_scene, write_stdout, write_stdout_text};
 use crate::story::{pixel_report, report_text};
 
 /// `tracelab inspect --help`.
@@ -65,12 +65,12 @@ pub fn run_inspect(a: &InspectArgs) -> anyhow::Result<()> {
     };
     let story = inspect_pixel(&scene, &compiled, &settings, x, row);
     let report = pixel_report(&scene, &story, &settings);
-    let text = if a.json {
-        serde_json::to_string_pretty(&report)
-            .map_err(|e| anyhow::anyhow!("cannot write JSON: {e}"))?
-            + "\n"
+    // Node labels carry the scene's text (an `obj_file` name): escaped, in JSON as \uXXXX.
+    if a.json {
+        let json = serde_json::to_string_pretty(&report)
+            .map_err(|e| anyhow::anyhow!("cannot write JSON: {e}"))?;
+        write_stdout(escape_json(json + "\n").as_bytes())
     } else {
-        report_text(&report)
-    };
-    write_stdout(text.as_bytes())
+        write_stdout_text(&report_text(&report))
+    }
 }

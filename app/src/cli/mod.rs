@@ -10,21 +10,24 @@ mod course;
 mod diff;
 mod fmt;
 mod inspect;
+mod mistyped;
 mod render;
 mod values;
 
+use std::borrow::Cow;
 use std::ffi::OsString;
-use std::io::Write;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 pub use course::parse_course_args;
 pub use render::{NormalMode, RenderArgs, RenderJob, run_render};
 
 use crate::bench::{BenchArgs, ProgressiveArgs};
-use crate::exit::Exit;
+use crate::exit::{Exit, usage};
+use crate::io::{write_stderr_text, write_stdout};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -81,31 +84,61 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Prints an error once, as its kind asks, and gives its exit code.
+/// Prints an error once, as its kind asks, and gives its exit code. Paths and names in the
+/// message are the user's text: escaped.
 fn report(e: &anyhow::Error) -> ExitCode {
     match e.downcast_ref::<Exit>() {
         Some(Exit::Usage(m)) => {
-            print_err(&format!("tracelab: {m}\nTry 'tracelab --help'.\n"));
+            write_stderr_text(&format!("tracelab: {m}\nTry 'tracelab --help'.\n"));
             ExitCode::from(2)
         }
         Some(Exit::UsagePrinted) => ExitCode::from(2),
         Some(Exit::OutputClosed) => ExitCode::SUCCESS,
         Some(Exit::Differs) => ExitCode::from(3),
         Some(Exit::HeatMapNotWritten { matched, message }) => {
-            print_err(&format!("{message}\n"));
+            write_stderr_text(&format!("{message}\n"));
             ExitCode::from(if *matched { 4 } else { 5 })
         }
         None => {
             let m = e.to_string();
-            print_err(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }));
+            write_stderr_text(&format!("{m}{}", if m.ends_with('\n') { "" } else { "\n" }));
             ExitCode::from(1)
         }
     }
 }
 
-/// Writes to standard error; with standard error closed or full there is no one left to tell.
-fn print_err(text: &str) {
-    let _ = std::io::stderr().lock().write_all(text.as_bytes());
+/// What clap has to say: help and version through [`write_stdout`] (so a closed or full
+/// standard output is an error) unless it is a terminal, where clap's colours are kept;
+/// usage errors, which quote the arguments, in clap's colours unless an argument holds a
+/// control character, then without colours and escaped.
+fn clap_says(e: &clap::Error, args: &[OsString]) -> anyhow::Result<()> {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        if std::io::stdout().is_terminal() {
+            let _ = e.print();
+            return Ok(());
+        }
+        return write_stdout(e.render().to_string().as_bytes());
+    }
+    let plain = |a: &OsString| {
+        let a = a.to_string_lossy();
+        matches!(tracelab_core::format::escape_controls(&a), Cow::Borrowed(_))
+    };
+    if args.iter().all(plain) {
+        let _ = e.print();
+    } else {
+        // The same error without clap's styles: only the user's bytes are left to escape
+        // (clap's own plain text would drop them, and only when not on a terminal).
+        let text = match Cli::command()
+            .styles(clap::builder::Styles::plain())
+            .try_get_matches_from(args)
+        {
+            Err(unstyled) => unstyled.render().ansi().to_string(),
+            Ok(_) => e.render().to_string(),
+        };
+        write_stderr_text(&text);
+    }
+    Err(Exit::UsagePrinted.into())
 }
 
 pub fn run(args: &[OsString]) -> anyhow::Result<()> {
@@ -130,16 +163,8 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
     }
     let cli = match Cli::try_parse_from(args) {
         Ok(c) => c,
-        Err(e) => {
-            // --help and --version print and succeed; real usage errors exit 2.
-            let _ = e.print();
-            return match e.kind() {
-                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
-                    Ok(())
-                }
-                _ => Err(Exit::UsagePrinted.into()),
-            };
-        }
+        // --help and --version print and succeed; real usage errors exit 2.
+        Err(e) => return clap_says(&e, args),
     };
     match cli.command {
         Some(Command::Render(r)) => run_render(&render::render_job(r)?),
@@ -153,7 +178,15 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
                 crate::bench::run_progressive(&b)
             })
         }
-        None => crate::gui::run(cli.scene),
+        None => {
+            let commands = Cli::command();
+            if let Some(m) = cli.scene.as_deref().and_then(|p| {
+                mistyped::mistyped_command(p, commands.get_subcommands().map(|c| c.get_name()))
+            }) {
+                return Err(usage(m));
+            }
+            crate::gui::run(cli.scene)
+        }
     }
 }
 

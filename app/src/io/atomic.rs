@@ -265,13 +265,18 @@ fn commit_named(
 
 /// Test hook: with `TRACELAB_TEST_STALL_BEFORE_RENAME` set, stop for a minute once the
 /// bytes are written and synced but not yet in place, so a test can kill the process at
-/// exactly the moment that matters (tests/cli.rs). Says so on stderr.
+/// exactly the moment that matters (tests/cli.rs). Says so on stderr. Only in debug builds
+/// (what `cargo test` builds): a release binary has no such hook, nor the variable's name.
+#[cfg(debug_assertions)]
 fn test_stall() {
     if std::env::var_os("TRACELAB_TEST_STALL_BEFORE_RENAME").is_some() {
         eprintln!("tracelab: test hook: stalled before rename");
         std::thread::sleep(std::time::Duration::from_secs(60));
     }
 }
+
+#[cfg(not(debug_assertions))]
+fn test_stall() {}
 
 /// The Linux path: `O_TMPFILE`, then `linkat` to a fresh name and `renameat` over the target.
 #[cfg(target_os = "linux")]

@@ -1,13 +1,14 @@
 //! Files in and out, for the command line and the editor alike: scene files read with
 //! their meshes, outputs written atomically ([`write_atomic`]), images encoded
-//! ([`write_image`]), standard output written with its errors checked ([`write_stdout`]),
-//! and the output policy every command's files go through first ([`OutputPlan`]).
+//! ([`write_image`]), standard output written with its errors checked and user text escaped
+//! ([`write_stdout`], [`write_stdout_text`]), and the output policy every command's files go
+//! through first ([`OutputPlan`]).
 
 mod atomic;
 mod image;
 pub mod output;
+mod stdout;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::{MeshCache, Scene};
@@ -15,8 +16,7 @@ use tracelab_core::{MeshCache, Scene};
 pub use atomic::{AtomicFile, write_atomic};
 pub use image::{ImageWriteError, encode_image, image_format, write_image};
 pub use output::{Implicit, OutputError, OutputPlan, write_implicit};
-
-use crate::exit::Exit;
+pub use stdout::{escape_json, escape_text, write_stderr_text, write_stdout, write_stdout_text};
 
 /// A scene file as read, before it replaces the document: on any thread, so that a large
 /// mesh cannot freeze the window, and before asking about unsaved changes, so that nothing
@@ -103,22 +103,10 @@ fn warn_or_fail(outcome: tracelab_core::ParseOutcome) -> anyhow::Result<Scene> {
     match outcome.into_result() {
         Ok((scene, warnings)) => {
             for w in warnings.warnings() {
-                eprintln!("{w}");
+                write_stderr_text(&format!("{w}\n"));
             }
             Ok(scene)
         }
         Err(diags) => Err(anyhow::Error::msg(diags.to_string())),
-    }
-}
-
-/// Writes to standard output, checking the write and the flush: a reader that closed the
-/// pipe (`| head`) wanted no more, which ends the run quietly ([`Exit::OutputClosed`]);
-/// anything else (a full disk) is an error.
-pub fn write_stdout(bytes: &[u8]) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
-    match out.write_all(bytes).and_then(|()| out.flush()) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(Exit::OutputClosed.into()),
-        Err(e) => Err(anyhow::anyhow!("standard output: cannot write: {e}")),
     }
 }
