@@ -6,6 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use tracelab_core::{NodeId, RenderSettings};
 
+use super::progress::Progress;
 use super::render::{NormalMode, ObjectRaysMode};
 use crate::animation::{AnimateError, Sweep, render_frames, write_frames};
 use crate::exit::{check_size, usage};
@@ -48,6 +49,9 @@ pub struct AnimateArgs {
     pub stem: String,
 }
 
+/// The frames' bar.
+const ANIMATE_PROGRESS: &str = "frames {pos}/{len} [{bar:30}] ({elapsed}, about {eta} left)";
+
 pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     let &[w, h] = a.size.as_slice() else {
         return Err(usage("--size needs W H"));
@@ -74,7 +78,12 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
         ..RenderSettings::new(w, h)
     };
     let never = AtomicBool::new(false);
-    let frames = match render_frames(&scene, &sweep, &settings, a.compare, &never, |_| {}) {
+    let mut bar = Progress::on_stderr(ANIMATE_PROGRESS, u64::from(a.frames));
+    let frames = render_frames(&scene, &sweep, &settings, a.compare, &never, |done| {
+        bar.set(u64::from(done));
+    });
+    bar.finish();
+    let frames = match frames {
         Ok(f) => f,
         Err(AnimateError::Refused(m)) => return Err(anyhow::anyhow!("{}: {m}", a.scene.display())),
         Err(AnimateError::Cancelled) => return Err(anyhow::anyhow!("cancelled")),

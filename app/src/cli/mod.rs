@@ -9,6 +9,7 @@ mod course;
 mod diff;
 mod fmt;
 mod inspect;
+mod progress;
 mod render;
 mod values;
 
