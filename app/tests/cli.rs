@@ -479,7 +479,7 @@ fn bench_into_a_closed_pipe_ends_quietly() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn bench_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("bench-full");
     let full = mknod(&d, "full", 7);
@@ -513,7 +513,7 @@ fn bench_to_a_full_standard_output_is_an_error() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn fmt_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("stdout-full");
     let full = mknod(&d, "full", 7);
@@ -540,7 +540,7 @@ fn fmt_to_a_full_standard_output_is_an_error() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn writing_to_a_full_device_fails_for_every_output_and_leaves_the_node() {
     let d = temp_dir("full");
     let scene = repo().join("scenes/inside_sphere.txt");

@@ -28,7 +28,8 @@ pub enum Compare {
     Split,
 }
 
-/// View settings (persisted between runs).
+/// The render view's settings. Three are kept between runs (`gui/settings.rs`): the tab,
+/// shade back and the depth range; the others start at their defaults every run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ViewSettings {
     pub tab: Tab,
