@@ -51,6 +51,22 @@ fn help_lists_subcommands_and_succeeds() {
     );
 }
 
+/// The command-line build (`--no-default-features`, no `gui` feature) has no editor: with
+/// no arguments, or a SCENE, it says so and how to get one, and exits 2.
+#[cfg(not(feature = "gui"))]
+#[test]
+fn without_the_gui_feature_the_editor_is_said_not_to_be_built_in() {
+    for args in [&[][..], &["scenes/default.txt"][..]] {
+        let o = tracelab(args, &repo());
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(
+            e.contains("the editor is not built in") && e.contains("cargo install --path app"),
+            "{args:?}: {e}"
+        );
+    }
+}
+
 #[test]
 fn missing_scene_file_exits_1_with_its_name() {
     let d = temp_dir("missing");

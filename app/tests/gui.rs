@@ -76,7 +76,7 @@ fn edit_save_undo(scene: PathBuf) {
     let original = h.state().doc.scene.clone();
     let (id, t) = translate_transform(h.state());
 
-    let label = tracelab::gui::panels::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    let label = tracelab::node_label::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
     h.get_all_by_label_contains(&label)
         .next()
         .expect("tree row")

@@ -25,6 +25,7 @@ pub fn temp_dir(area: &str, name: &str) -> PathBuf {
 
 /// Steps the UI until the scene is read and the renderer has finished the newest request,
 /// then once more so the last pixels are uploaded and drawn.
+#[cfg(feature = "gui")]
 pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>) {
     let start = std::time::Instant::now();
     loop {

@@ -8,7 +8,7 @@ use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::gizmo::Axes;
-use crate::gui::navigation::OnScreen;
+use crate::gui::on_screen::OnScreen;
 use crate::gui::overlays;
 use crate::gui::view_tools::ViewTools;
 use crate::render_worker::{Published, RenderWorker};
