@@ -8,7 +8,7 @@ use serde::Serialize;
 use tracelab_core::render::{Breaks, HitStory, RayStory, SimilitudeTest, quantize, similitude};
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
 
-use crate::gui::panels::tree::node_label;
+use crate::node_label::node_label;
 
 /// Bumped when a field changes meaning or goes away (adding one keeps it).
 pub const SCHEMA: &str = "tracelab-inspect/1";

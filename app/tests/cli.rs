@@ -51,6 +51,22 @@ fn help_lists_subcommands_and_succeeds() {
     );
 }
 
+/// The command-line build (`--no-default-features`, no `gui` feature) has no editor: with
+/// no arguments, or a SCENE, it says so and how to get one, and exits 2.
+#[cfg(not(feature = "gui"))]
+#[test]
+fn without_the_gui_feature_the_editor_is_said_not_to_be_built_in() {
+    for args in [&[][..], &["scenes/default.txt"][..]] {
+        let o = tracelab(args, &repo());
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(
+            e.contains("the editor is not built in") && e.contains("cargo install --path app"),
+            "{args:?}: {e}"
+        );
+    }
+}
+
 #[test]
 fn missing_scene_file_exits_1_with_its_name() {
     let d = temp_dir("missing");
@@ -514,7 +530,7 @@ fn bench_into_a_closed_pipe_ends_quietly() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn bench_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("bench-full");
     let full = mknod(&d, "full", 7);
@@ -548,7 +564,7 @@ fn bench_to_a_full_standard_output_is_an_error() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn fmt_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("stdout-full");
     let full = mknod(&d, "full", 7);
@@ -575,7 +591,7 @@ fn fmt_to_a_full_standard_output_is_an_error() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root: makes a private device node (mknod)"]
 fn writing_to_a_full_device_fails_for_every_output_and_leaves_the_node() {
     let d = temp_dir("full");
     let scene = repo().join("scenes/inside_sphere.txt");

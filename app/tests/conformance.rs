@@ -1,20 +1,14 @@
-//! Conformance with the course: runs every line of ../shared/mit6837/commands.txt (with
+//! Conformance with the course: runs every line of the course's `commands.txt` (with
 //! `tracelab` for `raytracer`) in a temporary copy of the course scenes and compares each
 //! image with the reference. An image passes when at least 99% of its pixels are within
-//! 8/255 on every channel. Skips, saying so, when ../shared is not there.
+//! 8/255 on every channel. The course's files are in `TRACELAB_COURSE_DIR` (default
+//! ../shared/mit6837); the test is `#[ignore]`d, and with `--ignored` it fails when they are
+//! missing.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::Command;
-
-fn shared() -> PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/mit6837");
-    assert!(
-        p.join("commands.txt").is_file(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        p.display()
-    );
-    p
-}
 
 fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).expect("create temp dir");
@@ -55,9 +49,9 @@ fn compare(out: &Path, reference: &Path) -> Result<(f64, u8), String> {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn every_course_command_line_matches_the_reference_images() {
-    let shared = shared();
+    let shared = common::course_dir();
     let dir = std::env::temp_dir().join(format!("tracelab-conformance-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     copy_dir(&shared.join("scenes"), &dir);

@@ -18,16 +18,12 @@ fn repo(rel: &str) -> PathBuf {
     common::repo().join(rel)
 }
 
-/// A course scene from ../shared. Tests that use one are `#[ignore]`d with the reason, so a
-/// plain `cargo test` lists them as ignored; run with `--include-ignored`, a missing
-/// ../shared fails them here.
-fn shared_scene(name: &str) -> PathBuf {
-    let p = repo("../shared/mit6837/scenes").join(name);
-    assert!(
-        p.is_file(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        p.display()
-    );
+/// A course scene (see `common::course_dir`). Tests that use one are `#[ignore]`d with the
+/// reason, so a plain `cargo test` lists them as ignored; run with `--ignored`, missing
+/// course files fail them here.
+fn course_scene(name: &str) -> PathBuf {
+    let p = common::course_dir().join("scenes").join(name);
+    assert!(p.is_file(), "{} is missing", p.display());
     p
 }
 
@@ -80,8 +76,7 @@ fn edit_save_undo(scene: PathBuf) {
     let original = h.state().doc.scene.clone();
     let (id, t) = translate_transform(h.state());
 
-    let label =
-        tracelab::gui::panels::tree::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    let label = tracelab::node_label::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
     h.get_all_by_label_contains(&label)
         .next()
         .expect("tree row")
@@ -146,9 +141,9 @@ fn edit_save_undo(scene: PathBuf) {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn course_scene_edit_save_and_undo() {
-    let scene = shared_scene("scene2_16_t_scale.txt");
+    let scene = course_scene("scene2_16_t_scale.txt");
     edit_save_undo(scene);
 }
 
@@ -616,9 +611,9 @@ fn the_picture_on_screen_follows_the_normal_switch_and_shade_back() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn shade_back_changes_the_picture_of_an_inside_view() {
-    let scene = shared_scene("scene2_05_inside_sphere.txt");
+    let scene = course_scene("scene2_05_inside_sphere.txt");
     let mut h = harness(Some(scene), (40, 40));
     settle(&mut h);
     let before = on_screen(&h);
@@ -826,14 +821,10 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     assert_eq!(obj_field(&h), cube, "after redo");
 }
 
-/// A scene using the 871k-triangle dragon of ../shared, written to a temporary folder.
+/// A scene using the 871k-triangle scanned dragon, written to a temporary folder.
 fn dragon_scene() -> PathBuf {
-    let dragon = repo("../shared/meshes/dragon_vrip.obj");
-    assert!(
-        dragon.is_file(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        dragon.display()
-    );
+    let dragon = common::meshes_dir().join("dragon_vrip.obj");
+    assert!(dragon.is_file(), "{} is missing", dragon.display());
     let path = temp_dir("dragon").join("dragon.txt");
     let text = SPHERE_SCENE
         .replace(
@@ -846,7 +837,7 @@ fn dragon_scene() -> PathBuf {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the scanned meshes: TRACELAB_MESHES_DIR, default ../shared/meshes"]
 fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_cancelled() {
     let dragon = dragon_scene();
     let mut h = harness(None, (32, 32));
@@ -899,7 +890,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the scanned meshes: TRACELAB_MESHES_DIR, default ../shared/meshes"]
 fn a_large_scene_given_at_start_does_not_hold_up_the_first_frame() {
     let dragon = dragon_scene();
     // What eframe does with `tracelab dragon.txt`: make the app, then paint frames.
@@ -1487,7 +1478,7 @@ fn a_remembered_1000_px_panel_is_clamped_and_reset_layout_restores_the_defaults(
 /// scene2_11 (orthographic camera, one light, `Scale 1 0.2 1` around a sphere) copied to a
 /// folder of its own and opened.
 fn squashed_sphere(tag: &str) -> (Harness<'static, TracelabApp>, PathBuf) {
-    let src = shared_scene("scene2_11_squashed_sphere.txt");
+    let src = course_scene("scene2_11_squashed_sphere.txt");
     let path = temp_dir(tag).join("squashed.txt");
     std::fs::copy(&src, &path).expect("copy");
     let mut h = harness(Some(path.clone()), (16, 16));
@@ -1540,7 +1531,7 @@ fn sphere_radius(scene: &tracelab_core::Scene) -> f32 {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
     let (mut h, path) = squashed_sphere("mesh-save");
     let before = std::fs::read_to_string(&path).expect("read");
@@ -1573,7 +1564,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
     let (mut h, path) = squashed_sphere("nan");
     select_row(&mut h, "Sphere: (0, 0, 0) r 1");
@@ -1598,7 +1589,7 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn scale_y_zero_on_the_squashed_sphere_is_refused_and_ctrl_s_leaves_a_file_that_opens() {
     let (mut h, path) = squashed_sphere("scale0");
     select_row(&mut h, "Transform: Scale(1, 0.2, 1)");
@@ -1618,7 +1609,7 @@ fn scale_y_zero_on_the_squashed_sphere_is_refused_and_ctrl_s_leaves_a_file_that_
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn an_orthographic_size_of_zero_is_refused_and_the_saved_file_opens() {
     let (mut h, path) = squashed_sphere("size0");
     select_row(&mut h, "Camera (orthographic)");
@@ -1632,7 +1623,7 @@ fn an_orthographic_size_of_zero_is_refused_and_the_saved_file_opens() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn a_camera_direction_parallel_to_up_is_refused_and_the_saved_file_opens() {
     let (mut h, path) = squashed_sphere("parallel");
     select_row(&mut h, "Camera (orthographic)");
@@ -1653,7 +1644,7 @@ fn a_camera_direction_parallel_to_up_is_refused_and_the_saved_file_opens() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
     let (mut h, path) = squashed_sphere("light0");
     select_row(&mut h, "Light 0");
@@ -1673,7 +1664,7 @@ fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn a_tiny_uniform_scale_is_fine_and_the_saved_file_opens() {
     let (mut h, path) = squashed_sphere("tiny");
     select_row(&mut h, "Transform: Scale(1, 0.2, 1)");

@@ -13,9 +13,10 @@ use glam::Vec3;
 use tracelab::document::Selection;
 use tracelab::gui::command::AppCommand;
 use tracelab::gui::gizmo::{Axes, Handle};
-use tracelab::gui::navigation::{OnScreen, ViewBasis};
+use tracelab::gui::on_screen::OnScreen;
 use tracelab::gui::view_tools::ViewTools;
 use tracelab::gui::{AppOptions, TracelabApp};
+use tracelab::navigation::ViewBasis;
 use tracelab_core::{Camera, MeshCache, NodeId, NodeKind, TransformOp};
 
 const SIZE: (u32, u32) = (160, 160);
@@ -321,7 +322,7 @@ fn f_frames_the_selection_home_frames_all_and_7_looks_down() {
     let objects = "Transform { Translate 6 3 -4 Sphere { center 0 0 0 radius 0.5 } }";
     let mut h = harness(scene_file("frame", objects, PERSPECTIVE));
     let s = sphere(&h);
-    let bounds = tracelab::gui::bounds::world_bounds(&h.state().doc.scene, s).expect("bounded");
+    let bounds = tracelab::bounds::world_bounds(&h.state().doc.scene, s).expect("bounded");
     assert!(
         !inside_the_image(&h, bounds),
         "the test needs the sphere out of view at first"
@@ -358,7 +359,7 @@ fn f_frames_the_selection_home_frames_all_and_7_looks_down() {
     );
     assert_eq!((c.direction(), c.up()), (Vec3::NEG_Y, Vec3::NEG_Z));
     let root = h.state().doc.scene.graph.root();
-    let all = tracelab::gui::bounds::world_bounds(&h.state().doc.scene, root).expect("bounded");
+    let all = tracelab::bounds::world_bounds(&h.state().doc.scene, root).expect("bounded");
     assert!(inside_the_image(&h, all));
 }
 
@@ -392,7 +393,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     let s = sphere(&h);
     select(&mut h, s);
     let v = view(&h);
-    let centre = tracelab::gui::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
+    let centre = tracelab::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
     let c0 = v.project(centre).expect("visible");
     let drawn0 = red_centroid(&h);
     let grab = gizmo_point(&h, Handle::Move(0));
@@ -421,7 +422,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
         panic!("{ops:?}")
     };
     assert_eq!((t.y, t.z), (0.0, 0.0), "only x moves");
-    let centre1 = tracelab::gui::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
+    let centre1 = tracelab::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
     let c1 = view(&h).project(centre1).expect("visible");
     let moved = c1 - c0;
     assert!(
@@ -445,7 +446,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert_eq!(
-        tracelab::gui::bounds::world_centre(&h.state().doc.scene, s),
+        tracelab::bounds::world_centre(&h.state().doc.scene, s),
         Some(centre)
     );
 }

@@ -3,9 +3,12 @@
 //! course command line). Every expected number here is computed in the test from the scene's
 //! own numbers (f64, by hand-written formulas), not taken from tracelab.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::repo;
 use glam::{DMat3, DMat4, DVec3};
 use serde_json::Value;
 
@@ -15,10 +18,6 @@ fn tracelab(args: &[&str], dir: &Path) -> Output {
         .current_dir(dir)
         .output()
         .expect("run tracelab")
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -534,14 +533,9 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
 }
 
 #[test]
-#[ignore = "needs ../shared/mit6837"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn diff_accepts_the_courses_own_reference_images() {
-    let shared = repo().join("../shared/mit6837");
-    assert!(
-        shared.join("scenes").is_dir(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        shared.display()
-    );
+    let shared = common::course_dir();
     let dir = temp_dir("diff-course");
     for f in ["scene2_11_squashed_sphere.txt", "scene2_16_t_scale.txt"] {
         std::fs::copy(shared.join("scenes").join(f), dir.join(f)).expect("copy scene");

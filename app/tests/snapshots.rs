@@ -51,7 +51,7 @@ fn settled_harness() -> Harness<'static, TracelabApp> {
 }
 
 #[test]
-#[ignore = "needs lavapipe (WGPU_BACKEND=vulkan, VK_DRIVER_FILES): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs lavapipe: WGPU_BACKEND=vulkan and VK_DRIVER_FILES as .ci/run sets them"]
 fn main_window_on_the_default_scene() {
     require_pinned_backend();
     let mut h = settled_harness();
@@ -59,7 +59,7 @@ fn main_window_on_the_default_scene() {
 }
 
 #[test]
-#[ignore = "needs lavapipe (WGPU_BACKEND=vulkan, VK_DRIVER_FILES): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs lavapipe: WGPU_BACKEND=vulkan and VK_DRIVER_FILES as .ci/run sets them"]
 fn pixel_inspector_open() {
     require_pinned_backend();
     let mut h = settled_harness();

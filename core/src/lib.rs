@@ -9,6 +9,12 @@ pub mod memory;
 pub mod render;
 pub mod scene;
 pub mod simd;
+// The tests' data folders (TRACELAB_MESHES_DIR, …), read in one file for every test; the
+// unit tests use only some of them.
+#[cfg(test)]
+#[path = "../tests/common/data.rs"]
+#[allow(dead_code)]
+mod test_data;
 
 pub use format::obj::{MESH_LOAD_CANCELLED, MeshCache, MeshEvent, MeshObserver};
 pub use format::{

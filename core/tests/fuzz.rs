@@ -1,12 +1,16 @@
-//! The fuzzing harness that stays: deterministic mutations of every scene under scenes/ and
-//! ../shared/mit6837/scenes through parser, writer, compiler and a 4×4 render, and of the OBJ
-//! meshes through both OBJ readers. Properties: no panic; every diagnostic has a location;
-//! an accepted scene writes back to text that reads as the same scene and renders the same
-//! pixels; the fast OBJ reader and tobj agree whenever the fast one accepts.
+//! The fuzzing harness that stays: deterministic mutations of scenes through parser,
+//! writer, compiler and a 4×4 render, and of OBJ meshes through both OBJ readers.
+//! Properties: no panic; every diagnostic has a location; an accepted scene writes back to
+//! text that reads as the same scene and renders the same pixels; the fast OBJ reader and
+//! tobj agree whenever the fast one accepts.
+//!
+//! The plain tests mutate only the checkout's own seeds (scenes/ and assets/). The course's
+//! scenes and meshes (`TRACELAB_COURSE_DIR`) are seeds of two tests of their own, `#[ignore]`d
+//! for needing them, which fail when they are missing.
 //!
 //! `TRACELAB_FUZZ_CASES=N` sets the number of cases per test (default 100,000 scenes,
-//! 50,000 OBJ files); `TRACELAB_FUZZ_CASE=K` replays case K alone. A failure prints the case
-//! number and its input as a byte string.
+//! 50,000 OBJ files); `TRACELAB_FUZZ_CASE=K` replays case K alone (with the same test's
+//! seeds). A failure prints the case number and its input as a byte string.
 
 mod common;
 
@@ -49,26 +53,19 @@ fn files_in(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Files from ours and from ../shared/mit6837 (skipped visibly when absent, unless CI
-/// requires it).
-fn seeds(ours: &[&str], shared: &str, ext: &str) -> Vec<(PathBuf, Vec<u8>)> {
+/// The files ending in `ext` under `dirs`, under 128 KiB (scenes/perf's generated
+/// 1,000-instance scene, 230 KiB, is too slow to mutate by the thousand for a grammar the
+/// small files cover; assets/torus.obj, 64.4 KiB, is needed: the checkout has 3 meshes),
+/// with their bytes.
+fn seeds(dirs: &[PathBuf], ext: &str) -> Vec<(PathBuf, Vec<u8>)> {
     let mut paths = Vec::new();
-    for d in ours {
-        files_in(&repo().join(d), ext, &mut paths);
-    }
-    let shared_dir = repo().join("../shared/mit6837").join(shared);
-    if shared_dir.is_dir() {
-        files_in(&shared_dir, ext, &mut paths);
-    } else {
-        // Not a skip: the harness still runs, on the project's own seeds.
-        skip_note(&format!(
-            "NOTE: {} not found; fuzzing our own seeds only",
-            shared_dir.display()
-        ));
+    for d in dirs {
+        files_in(d, ext, &mut paths);
     }
     paths
         .into_iter()
         .filter_map(|p| std::fs::read(&p).ok().map(|b| (p, b)))
+        .filter(|(_, b)| b.len() < 128 << 10)
         .collect()
 }
 
@@ -302,15 +299,25 @@ fn scene_case(input: &[u8], dir: &Path, cache: &mut MeshCache) -> Result<(), Str
     Ok(())
 }
 
+/// Seeds: the checkout's scenes/ only; the course's are the next test's.
 #[test]
 fn mutated_scenes_never_panic_and_accepted_ones_round_trip() {
-    // scenes/perf's generated 1,000-instance scene would take a third of the run for a grammar
-    // the small scenes cover.
-    let seeds: Vec<_> = seeds(&["scenes"], "scenes", "txt")
-        .into_iter()
-        .filter(|(_, b)| b.len() < 64 << 10)
-        .collect();
+    let seeds = seeds(&[repo().join("scenes")], "txt");
     assert!(seeds.len() >= 20, "only {} seed scenes", seeds.len());
+    fuzz_scenes(&seeds);
+}
+
+/// Seeds: the course's scenes.
+#[test]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
+fn mutated_course_scenes_never_panic_and_accepted_ones_round_trip() {
+    let seeds = seeds(&[common::course_dir().join("scenes")], "txt");
+    assert!(seeds.len() >= 20, "only {} seed scenes", seeds.len());
+    fuzz_scenes(&seeds);
+}
+
+/// Mutations of `seeds` through parser, writer, compiler and a 4×4 render.
+fn fuzz_scenes(seeds: &[(PathBuf, Vec<u8>)]) {
     let n = fuzz_cases(100_000);
     let accepted = std::sync::atomic::AtomicU64::new(0);
     run_cases("scene fuzz", n, |k, cache| {
@@ -417,15 +424,25 @@ fn obj_case(input: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// Seeds: the checkout's assets/ only; the course's meshes are the next test's.
 #[test]
 fn mutated_obj_files_never_panic_and_both_readers_agree() {
-    // The dragon and the big bunny are too slow to mutate by the thousand; the small meshes
-    // cover the format.
-    let seeds: Vec<_> = seeds(&["assets"], "scenes", "obj")
-        .into_iter()
-        .filter(|(_, b)| b.len() < 64 << 10)
-        .collect();
+    let seeds = seeds(&[repo().join("assets")], "obj");
     assert!(seeds.len() >= 3, "only {} seed meshes", seeds.len());
+    fuzz_objs(&seeds);
+}
+
+/// Seeds: the meshes among the course's scenes.
+#[test]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
+fn mutated_course_obj_files_never_panic_and_both_readers_agree() {
+    let seeds = seeds(&[common::course_dir().join("scenes")], "obj");
+    assert!(seeds.len() >= 3, "only {} seed meshes", seeds.len());
+    fuzz_objs(&seeds);
+}
+
+/// Mutations of `seeds` through both OBJ readers.
+fn fuzz_objs(seeds: &[(PathBuf, Vec<u8>)]) {
     let n = fuzz_cases(100_000) / 2;
     run_cases("OBJ fuzz", n, |k, _| {
         let mut rng = Rng::for_case(OBJ_SEED, k);

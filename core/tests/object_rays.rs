@@ -3,26 +3,15 @@
 //! bug: wrong depths, and between objects of different scales the wrong one in front).
 //! Expected depths here are worked out by hand from the scenes' numbers, not by the renderer.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::Path;
+
+use common::repo;
 use tracelab_core::render::inspect_pixel;
 use tracelab_core::{
     Frame, MeshCache, ObjectRays, RenderSettings, Scene, View, compile, load_scene, render_frame,
 };
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn shared() -> PathBuf {
-    let p = repo().join("../shared/mit6837");
-    assert!(
-        p.join("scenes").is_dir(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        p.display()
-    );
-    p
-}
 
 fn load(path: &Path) -> Scene {
     load_scene(path, &mut MeshCache::new())
@@ -242,11 +231,11 @@ fn the_inspector_reports_t_in_both_spaces_and_the_one_kept() {
 
 /// scene2_16_t_scale: spheres under Scale 5, 2, 1 and 0.5; the depth image is t in [2, 7].
 fn t_scale() -> Scene {
-    load(&shared().join("scenes/scene2_16_t_scale.txt"))
+    load(&common::course_dir().join("scenes/scene2_16_t_scale.txt"))
 }
 
 #[test]
-#[ignore = "needs ../shared/mit6837"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn t_scale_renders_the_same_with_normalised_rays_and_rescaled_t() {
     let s = t_scale();
     let a = render(&s, 200, 200, ObjectRays::Unnormalized);
@@ -255,7 +244,7 @@ fn t_scale_renders_the_same_with_normalised_rays_and_rescaled_t() {
 }
 
 #[test]
-#[ignore = "needs ../shared/mit6837"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn t_scale_without_rescaling_has_scaled_depths_and_yellow_falls_behind_green() {
     let s = t_scale();
     let (w, h) = (200, 200);

@@ -1,7 +1,7 @@
 //! The renderer's primary rays as packets (`Tracing::Packets`, what every render uses) give
 //! the image single rays give, bit for bit: colour, normal, t and object id of every pixel,
 //! in one full pass and through the progressive passes (whose coarse samples are sparse
-//! packets), on tracelab's scenes, on the course's and perf scenes in ../shared and on
+//! packets), on tracelab's scenes, on the course's and perf scenes (`TRACELAB_COURSE_DIR`, `TRACELAB_PERF_DIR`) and on
 //! scenes/perf's 1,000 bunny instances, under both normal rules and with and without
 //! shade_back.
 
@@ -63,12 +63,7 @@ fn check(path: &Path, (w, h): (u32, u32)) {
 
 fn txt_files(dir: &Path, prefix: &str) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}: {e}: this test needs ../shared beside the checkout",
-                dir.display()
-            )
-        })
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "txt"))
         .filter(|p| {
@@ -108,16 +103,15 @@ fn packets_match_single_rays_on_tracelab_s_scenes() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files and the perf scenes with their meshes: TRACELAB_COURSE_DIR, TRACELAB_PERF_DIR, defaults ../shared/mit6837, ../shared/perf"]
 fn packets_match_single_rays_on_the_course_and_perf_scenes() {
-    let shared = common::repo().join("../shared");
-    let course = txt_files(&shared.join("mit6837/scenes"), "scene");
+    let course = txt_files(&common::course_dir().join("scenes"), "scene");
     assert!(course.len() >= 20, "{course:?}");
     for s in &course {
         check(s, (101, 75));
     }
     // The perf scenes' meshes (bunny 69k, dragon 871k) at a size that keeps this quick.
-    let perf = txt_files(&shared.join("perf"), "bench_");
+    let perf = txt_files(&common::perf_dir(), "bench_");
     assert_eq!(perf.len(), 4, "{perf:?}");
     for s in &perf {
         check(s, (64, 48));

@@ -1,5 +1,5 @@
 //! End-to-end on real scene files: the scenes in scenes/ and the course's scenes in
-//! ../shared/mit6837 (a test `#[ignore]`d for needing ../shared) parse cleanly, render, and survive a
+//! `TRACELAB_COURSE_DIR` (a test `#[ignore]`d for needing them) parse cleanly, render, and survive a
 //! write → read round trip unchanged, in the course's own grammar unless they use one of
 //! tracelab's extensions (scenes/lecture/ has Box and CSG scenes).
 
@@ -28,13 +28,8 @@ fn scenes_in(dir: &str) -> Vec<PathBuf> {
 }
 
 fn course_scenes() -> Vec<PathBuf> {
-    let dir = repo().join("../shared/mit6837/scenes");
-    let rd = std::fs::read_dir(&dir).unwrap_or_else(|e| {
-        panic!(
-            "{}: {e}: this test needs ../shared beside the checkout",
-            dir.display()
-        )
-    });
+    let dir = common::course_dir().join("scenes");
+    let rd = std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     let mut v: Vec<PathBuf> = rd
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "txt"))
@@ -218,7 +213,7 @@ fn lecture_scenes_parse_render_and_round_trip() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn course_scenes_round_trip_in_the_course_grammar() {
     let scenes = course_scenes();
     assert_eq!(scenes.len(), 23);

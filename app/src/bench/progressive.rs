@@ -10,8 +10,8 @@ use tracelab_core::render::render_coarse;
 use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
 use tracelab_core::{CompiledScene, RenderSettings, Scene, render_progressive};
 
-use crate::gui::bounds::world_bounds;
-use crate::gui::navigation::orbit;
+use crate::bounds::world_bounds;
+use crate::navigation::orbit;
 
 use super::{ProgressiveArgs, median};
 use crate::exit::check_size;

@@ -6,6 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use tracelab_core::{NodeId, RenderSettings};
 
+use super::progress::Progress;
 use super::render::{NormalMode, ObjectRaysMode};
 use crate::animation::{AnimateError, Destination, Sweep, check_stem, export, frame_size};
 use crate::exit::{check_size, usage};
@@ -49,6 +50,9 @@ pub struct AnimateArgs {
     pub stem: String,
 }
 
+/// The frames' bar.
+const ANIMATE_PROGRESS: &str = "frames {pos}/{len} [{bar:30}] ({elapsed}, about {eta} left)";
+
 pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
     let &[w, h] = a.size.as_slice() else {
         return Err(usage("--size needs W H"));
@@ -84,7 +88,12 @@ pub fn run_animate(a: &AnimateArgs) -> anyhow::Result<()> {
         inputs: std::iter::once(a.scene.clone()).chain(meshes).collect(),
     };
     let never = AtomicBool::new(false);
-    match export(&scene, &sweep, &settings, a.compare, &to, &never, |_| {}) {
+    let mut bar = Progress::on_stderr(ANIMATE_PROGRESS, u64::from(a.frames));
+    let result = export(&scene, &sweep, &settings, a.compare, &to, &never, |done| {
+        bar.set(u64::from(done));
+    });
+    bar.finish();
+    match result {
         Ok(files) => {
             if let Some(last) = files.last() {
                 crate::io::write_stderr_text(&format!(

@@ -11,6 +11,7 @@ mod diff;
 mod fmt;
 mod inspect;
 mod mistyped;
+mod progress;
 mod render;
 mod values;
 
@@ -185,9 +186,23 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
             }) {
                 return Err(usage(m));
             }
-            crate::gui::run(cli.scene)
+            open_editor(cli.scene)
         }
     }
+}
+
+#[cfg(feature = "gui")]
+fn open_editor(scene: Option<PathBuf>) -> anyhow::Result<()> {
+    crate::gui::run(scene)
+}
+
+/// A command-line build (`--no-default-features`) has no editor: say so, and how to get one.
+#[cfg(not(feature = "gui"))]
+fn open_editor(_scene: Option<PathBuf>) -> anyhow::Result<()> {
+    Err(crate::exit::usage(
+        "the editor is not built in: this tracelab was built without the cargo feature `gui`.\n\
+         To get it, build with the default features: cargo install --path app",
+    ))
 }
 
 fn with_threads(

@@ -2,16 +2,16 @@
 //! colour, normal and depth images.
 
 use std::ffi::OsString;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use clap::ValueEnum;
 use tracelab_core::render::{SharedFrame, render_full};
 use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
+use super::progress::Progress;
 use super::values::parse_f32;
 use crate::exit::{check_size, usage};
 use crate::io::{OutputError, OutputPlan, load_scene_and_meshes};
@@ -217,6 +217,9 @@ pub(super) fn check_memory(width: u32, height: u32) -> anyhow::Result<()> {
         .map_err(|_| out_of_memory(width, height))
 }
 
+/// The render's bar: share of the tiles done.
+const RENDER_PROGRESS: &str = "rendering [{bar:30}] {percent:>3}% ({elapsed}, about {eta} left)";
+
 /// Renders at full resolution; shows a progress bar on a terminal once it takes over a second.
 /// The frame is allocated fallibly.
 pub(super) fn render_with_progress(
@@ -228,28 +231,15 @@ pub(super) fn render_with_progress(
             .map_err(|_| out_of_memory(settings.width, settings.height))?,
     );
     let done = Arc::new(AtomicBool::new(false));
-    let watcher = std::io::stderr().is_terminal().then(|| {
+    let mut bar = Progress::on_stderr(RENDER_PROGRESS, 1000);
+    let watcher = bar.on_terminal().then(|| {
         let (target, done) = (target.clone(), done.clone());
         std::thread::spawn(move || {
-            let start = Instant::now();
-            let mut shown = false;
             while !done.load(Ordering::Relaxed) {
                 std::thread::sleep(Duration::from_millis(100));
-                if start.elapsed() > Duration::from_secs(1) {
-                    let p = target.progress();
-                    let bar = (p * 30.0) as usize;
-                    eprint!(
-                        "\rrendering [{}{}] {:3.0}%",
-                        "#".repeat(bar),
-                        " ".repeat(30 - bar.min(30)),
-                        p * 100.0
-                    );
-                    shown = true;
-                }
+                bar.set((target.progress() * 1000.0) as u64);
             }
-            if shown {
-                eprintln!("\rrendering [{}] 100%", "#".repeat(30));
-            }
+            bar.finish();
         })
     });
     let never = AtomicBool::new(false);

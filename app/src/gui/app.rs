@@ -28,9 +28,9 @@ use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree};
 use crate::gui::ray_diagram::Orbit;
 use crate::gui::settings::Settings;
 use crate::gui::view_tools;
-use crate::gui::{bounds, navigation};
 use crate::io::{SceneRead, read_scene_file};
 use crate::render_worker::RenderWorker;
+use crate::{bounds, navigation};
 use glam::Vec3;
 
 #[derive(Clone, Debug, Default)]

@@ -9,7 +9,7 @@ use tracelab_core::NodeId;
 use crate::animation::AnimationForm;
 use crate::document::Selection;
 use crate::document::edit::Edit;
-use crate::gui::navigation::AxisView;
+use crate::navigation::AxisView;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum AppCommand {

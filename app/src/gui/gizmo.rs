@@ -12,9 +12,9 @@
 use glam::{Mat4, Vec3};
 use tracelab_core::{NodeId, Scene, TransformOp};
 
+use crate::bounds::{world_centre, world_from_parent};
 use crate::document::op_target::{OpKind, OpTarget, op_target};
-use crate::gui::bounds::{world_centre, world_from_parent};
-use crate::gui::navigation::OnScreen;
+use crate::gui::on_screen::OnScreen;
 
 /// Arm length on screen, in points.
 const ARM: f32 = 90.0;

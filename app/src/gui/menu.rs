@@ -4,7 +4,7 @@
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 use crate::gui::command::AppCommand;
-use crate::gui::navigation::AxisView;
+use crate::navigation::AxisView;
 
 pub struct Entry {
     pub command: AppCommand,

@@ -3,7 +3,6 @@
 
 pub mod animation_dialog;
 pub mod app;
-pub mod bounds;
 pub mod command;
 pub mod drag_speed;
 pub mod file_dialog;
@@ -14,7 +13,7 @@ pub mod lecture;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
-pub mod navigation;
+pub mod on_screen;
 pub mod overlays;
 pub mod panels;
 pub mod ray_diagram;

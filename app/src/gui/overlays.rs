@@ -5,7 +5,7 @@
 use glam::Vec3;
 use tracelab_core::{Frame, NodeId, Scene};
 
-use crate::gui::navigation::ViewBasis;
+use crate::navigation::ViewBasis;
 
 const OUTLINE: [u8; 4] = [255, 150, 20, 255];
 

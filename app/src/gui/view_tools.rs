@@ -8,12 +8,13 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3};
 use tracelab_core::Camera;
 
+use crate::bounds::{world_bounds, world_centre};
 use crate::document::edit::Edit;
 use crate::document::{Document, Selection};
-use crate::gui::bounds::{world_bounds, world_centre};
 use crate::gui::command::AppCommand;
 use crate::gui::gizmo::{Axes, Gizmo, GizmoDrag, Handle};
-use crate::gui::navigation::{self, OnScreen, ViewBasis};
+use crate::gui::on_screen::OnScreen;
+use crate::navigation::{self, ViewBasis};
 
 /// The render counts as "moving" this long after the last pointer motion or wheel notch:
 /// meanwhile only coarse passes are rendered.

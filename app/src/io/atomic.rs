@@ -441,7 +441,7 @@ mod tests {
 
     #[cfg(unix)]
     #[test]
-    #[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+    #[ignore = "needs root: chowns a file to another user"]
     fn replacing_as_root_keeps_the_owner_of_the_old_file() {
         let d = temp_dir("owner");
         let p = d.join("theirs.txt");
@@ -544,7 +544,7 @@ mod tests {
 
     #[cfg(unix)]
     #[test]
-    #[ignore = "needs root (private device nodes, chown, chattr): run with --include-ignored, as .ci/run does"]
+    #[ignore = "needs root: makes a private device node (mknod)"]
     fn a_full_device_is_written_into_reports_its_error_and_stays_a_device() {
         let d = temp_dir("full");
         let full = mknod(&d, "full", 7);

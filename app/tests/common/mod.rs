@@ -1,10 +1,15 @@
 //! Shared by app's integration tests.
 // Each test binary that includes this module uses only part of it.
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
 use std::path::{Path, PathBuf};
 
-/// The repository's root (scenes/, assets/; ../shared beside it).
+// The one reader of the data settings (TRACELAB_COURSE_DIR, …), shared with core's tests.
+#[path = "../../../core/tests/common/data.rs"]
+mod data;
+pub use data::{course_dir, meshes_dir, perf_dir};
+
+/// The repository's root (scenes/, assets/).
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
@@ -20,6 +25,7 @@ pub fn temp_dir(area: &str, name: &str) -> PathBuf {
 
 /// Steps the UI until the scene is read and the renderer has finished the newest request,
 /// then once more so the last pixels are uploaded and drawn.
+#[cfg(feature = "gui")]
 pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>) {
     let start = std::time::Instant::now();
     loop {

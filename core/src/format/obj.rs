@@ -358,14 +358,9 @@ mod tests {
     }
 
     #[test]
-    #[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+    #[ignore = "needs the scanned meshes: TRACELAB_MESHES_DIR, default ../shared/meshes"]
     fn fast_reader_matches_tobj_on_the_shared_meshes() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
-        assert!(
-            dir.is_dir(),
-            "{} is missing: this test needs ../shared beside the checkout",
-            dir.display()
-        );
+        let dir = crate::test_data::meshes_dir();
         // The dragon takes tobj seconds in a debug build; the smaller meshes cover the format.
         for name in ["cube.obj", "bunny_1k.obj", "stanford-bunny.obj"] {
             same_geometry(&dir.join(name));

@@ -1,11 +1,14 @@
 //! Shared by core's integration tests: the repository's root, private temporary folders, and
 //! for the parser fuzz tests a repeatable generator and the token mutations they use.
 // Each test binary that includes this module uses only part of it.
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
 use std::path::{Path, PathBuf};
 
-/// The repository's root (scenes/, assets/; ../shared beside it).
+mod data;
+pub use data::{course_dir, meshes_dir, perf_dir};
+
+/// The repository's root (scenes/, assets/).
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }

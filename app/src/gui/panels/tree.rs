@@ -7,6 +7,7 @@ use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 use crate::document::edit::Edit;
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
+use crate::node_label::node_label;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreeRow {
@@ -19,45 +20,6 @@ pub struct TreeRow {
     /// Why the node renders nothing or cannot be saved yet (a mesh that did not load, one
     /// with no file chosen): drawn in red.
     pub error: Option<String>,
-}
-
-/// A short summary of a node for its tree row.
-pub fn node_label(kind: &NodeKind, children: usize) -> String {
-    let v = |v: Vec3| format!("{}, {}, {}", v.x, v.y, v.z);
-    match kind {
-        NodeKind::Group => format!("Group ({children})"),
-        NodeKind::Transform(ops) if ops.is_empty() => "Transform: identity".into(),
-        NodeKind::Transform(ops) => {
-            format!(
-                "Transform: {}",
-                ops.iter()
-                    .map(TransformOp::summary)
-                    .collect::<Vec<_>>()
-                    .join(" · ")
-            )
-        }
-        NodeKind::Sphere { center, radius } => format!("Sphere: ({}) r {radius}", v(*center)),
-        NodeKind::Plane { normal, offset } => format!("Plane: n ({}) d {offset}", v(*normal)),
-        NodeKind::Triangle { .. } => "Triangle".into(),
-        NodeKind::TriangleMesh { obj_file, mesh } => match mesh {
-            MeshSlot::Loaded(m) => {
-                format!("TriangleMesh: {obj_file} ({} tris)", m.triangle_count())
-            }
-            MeshSlot::Failed(_) | MeshSlot::Unresolved => {
-                format!("TriangleMesh: {obj_file} (not loaded)")
-            }
-        },
-        NodeKind::Box { min, max } => format!("Box: ({}) to ({})", v(*min), v(*max)),
-        NodeKind::Csg(op) => {
-            // Words, not ∪ ∩ −: egui's default fonts have no glyphs for them.
-            let what = match op {
-                CsgOp::Union => "A or B",
-                CsgOp::Intersection => "A and B",
-                CsgOp::Subtraction => "A minus B",
-            };
-            format!("{}: {what}", op.name())
-        }
-    }
 }
 
 /// The object hierarchy as rows, parents first.

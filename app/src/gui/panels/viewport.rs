@@ -8,7 +8,7 @@ use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::gizmo::Axes;
-use crate::gui::navigation::OnScreen;
+use crate::gui::on_screen::OnScreen;
 use crate::gui::overlays;
 use crate::gui::view_tools::ViewTools;
 use crate::render_worker::{Published, RenderWorker};
@@ -28,7 +28,8 @@ pub enum Compare {
     Split,
 }
 
-/// View settings (persisted between runs).
+/// The render view's settings. Three are kept between runs (`gui/settings.rs`): the tab,
+/// shade back and the depth range; the others start at their defaults every run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ViewSettings {
     pub tab: Tab,

@@ -595,14 +595,9 @@ fn packets_on_empty_and_one_triangle_meshes() {
 }
 
 #[test]
-#[ignore = "needs ../shared beside the checkout: run with --include-ignored, as .ci/run does"]
+#[ignore = "needs the scanned meshes: TRACELAB_MESHES_DIR, default ../shared/meshes"]
 fn shared_meshes_agree_with_brute_force() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
-    assert!(
-        dir.is_dir(),
-        "{} is missing: this test needs ../shared beside the checkout",
-        dir.display()
-    );
+    let dir = crate::test_data::meshes_dir();
     // The dragon is left to the benchmark's checksums: brute force over 871k triangles
     // per ray is too slow for a unit test.
     for (name, rays) in [
