@@ -29,7 +29,8 @@
 //!   `inspect` and `diff`;
 //! - the editor never starts (no case names a scene for it; with no display it would say
 //!   "cannot open the window");
-//! - with standard output a full device, a command that prints its result does not exit 0.
+//! - with standard output a full device, a command that prints its result does not exit 0;
+//!   nor does one with an output file on a full device.
 //!
 //! `TRACELAB_CLI_FUZZ_CASES=N` sets the number of cases (default 10,000: about 3 minutes of
 //! CPU on 2 cores for the debug build); `TRACELAB_CLI_FUZZ_CASE=K` replays case K alone,
@@ -71,6 +72,9 @@ const MEMORY_KB: u64 = 2_000_000;
 const LOW_MEMORY_KB: u64 = 1_000_000;
 /// `ulimit -f` in 1 KiB blocks: no case may fill the disk.
 const FILE_KB: u64 = 1 << 20;
+/// `ulimit -t`: a backstop, so that a case orphaned by a killed harness cannot run for ever
+/// (the harness itself kills a case long before).
+const CPU_S: u64 = 600;
 const STDERR_TAIL: usize = 1500;
 
 fn note(msg: &str) {
@@ -168,7 +172,7 @@ fn run_case(
         ""
     };
     let script = format!(
-        "ulimit -v {} -c 0 -f {FILE_KB} || exit 99; {closed}exec \"$@\"",
+        "ulimit -v {} -c 0 -f {FILE_KB} -t {CPU_S} || exit 99; {closed}exec \"$@\"",
         memory_kb(case)
     );
     let stderr_file = std::fs::File::create(log.join("stderr")).expect("stderr file");
@@ -305,6 +309,9 @@ fn run_case(
     }
     if stderr.contains("cannot open the window") {
         wrong.push("the editor started".into());
+    }
+    if allowed.full_output && code == Some(0) {
+        wrong.push("an output is a full device (ENOSPC), yet exit 0".into());
     }
     if case.stdout == StdoutKind::Full && case.prints && code == Some(0) && !timed_out {
         wrong.push("standard output full (ENOSPC), yet exit 0".into());
@@ -446,11 +453,18 @@ fn generated_command_lines_never_crash_hang_or_touch_what_they_must_not() {
         let case_dir = root_dir.join(format!("case-{k}"));
         // Drawn apart from the case's own stream, so the lists stay as they were.
         let mut side = Rng::for_case(SEED ^ 0x10_3e3, k);
+        let low_memory = side.one_in(16);
+        // Two in ten cases all working values, three in ten one hostile choice, the rest 5%,
+        // 20% or 60% of their choices hostile.
+        let hostility = [0, 0, 0, 0, 0, 50, 50, 200, 200, 600][side.below(10)];
+        let single = (hostility == 0 && side.below(5) >= 2).then(|| side.below(24));
         Ctx {
             case_dir,
             nodes: machine.nodes,
-            low_memory: side.one_in(16),
-            hostility: [0, 50, 200, 600][side.below(4)],
+            low_memory,
+            hostility,
+            single,
+            choices: Default::default(),
         }
     };
 

@@ -112,6 +112,9 @@ impl Fixture {
         let files = vec![
             ("work/scene.txt", scene.clone()),
             ("work/sub/scene.txt", scene.clone()),
+            // A scene with an image's name: `render scene.png -o scene.png` passes the
+            // extension check and must still not write its input.
+            ("work/scene.png", scene.clone()),
             ("outside/scene.txt", scene.clone()),
             ("work/hier.txt", unassets(read("scenes/hierarchy.txt"))),
             ("work/csg.txt", read("scenes/lecture/csg_union.txt")),
@@ -371,6 +374,8 @@ pub struct Allowed {
     implicit: Vec<(PathBuf, Vec<Vec<u8>>)>,
     /// Outputs given with a trailing slash (a folder), as the file name without it.
     slashed: Vec<PathBuf>,
+    /// An explicit output is a full device: the write fails, so success would be a lie.
+    pub full_output: bool,
 }
 
 pub fn allowed(case: &Case, case_dir: &Path) -> Allowed {
@@ -408,7 +413,13 @@ pub fn allowed(case: &Case, case_dir: &Path) -> Allowed {
             Role::Output => {
                 // Written through its links (as `write_atomic` does), or the link itself
                 // replaced: either is the file the line asked for.
-                a.outputs.extend(written_path(case_dir, &work, p));
+                let target = written_path(case_dir, &work, p);
+                a.full_output |= target.as_ref().is_some_and(|t| {
+                    std::fs::metadata(case_dir.join(t)).is_ok_and(|m| {
+                        m.file_type().is_char_device() && m.rdev() == rustix::fs::makedev(1, 7)
+                    })
+                });
+                a.outputs.extend(target);
                 a.outputs.extend(lexical_path(case_dir, &work, p));
             }
             Role::AnimateOut => out_dir = Some(p.to_owned()),

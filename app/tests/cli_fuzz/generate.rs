@@ -150,11 +150,16 @@ pub struct Ctx {
     /// Per mille: how often a value is taken from the hostile lists rather than the
     /// working ones. A case with few hostile values gets past the checks to the work.
     pub hostility: usize,
+    /// Or exactly one hostile choice, the N-th: one fault at a time reaches furthest.
+    pub single: Option<usize>,
+    pub choices: std::cell::Cell<usize>,
 }
 
 impl Ctx {
     fn hostile(&self, rng: &mut Rng) -> bool {
-        rng.below(1000) < self.hostility
+        let n = self.choices.get();
+        self.choices.set(n + 1);
+        self.single == Some(n) || rng.below(1000) < self.hostility
     }
     /// A working value or, as often as the case is hostile, a hostile one.
     fn pick<'a>(&self, rng: &mut Rng, good: &'a str, bad: &'a str) -> &'a str {
@@ -233,7 +238,7 @@ fn scene_path(rng: &mut Rng, ctx: &Ctx) -> OsString {
                  bom.txt|bommesh.txt|flat.txt|huge_tri.txt|deep.txt|ctl.txt|fifomesh.txt|\
                  devmesh.txt|missingmesh.txt|pipe.txt|zero_dev|null_dev|sub|sub/|scene.txt/|\
                  missing.txt|dangling.txt|loop_a||-|/|../outside/scene.txt|\
-                 to_outside_dir/scene.txt|cube.obj|mine.png|-o.txt|.|..",
+                 to_outside_dir/scene.txt|cube.obj|mine.png|-o.txt|.|..|scene.png|scene.png",
             )
             .into(),
     }
@@ -256,7 +261,7 @@ fn image_out_path(rng: &mut Rng, ctx: &Ctx) -> OsString {
                  loop_a|to_outside.png|abs_outside.png|to_outside_dir/new.png|\
                  ../outside/new.png|../outside/target.png|../escaped.png|sub|sub/|out.png/|\
                  newdir/out.png|a/b/../../out.png|pipe.png|null.png|full.png|scene.txt|\
-                 mesh.txt|cube.obj|mine.png|mine.diff.png|frame_0000.png||.|..|-o.png",
+                 mesh.txt|cube.obj|mine.png|mine.diff.png|frame_0000.png||.|..|-o.png|scene.png",
             )
             .into(),
     }
@@ -748,6 +753,23 @@ pub fn generate(k: u64, ctx: &Ctx) -> Case {
             args
         }
     };
+    let mut args = args;
+    // A collision made on purpose: an output (or diff's image) named as one of the inputs.
+    if ctx.hostile(&mut rng) && rng.one_in(2) {
+        let pick = |args: &[Arg], roles: &[Role], rng: &mut Rng| {
+            let at: Vec<usize> = (0..args.len())
+                .filter(|&i| roles.contains(&args[i].role) && args[i].path.is_none())
+                .collect();
+            (!at.is_empty()).then(|| at[rng.below(at.len())])
+        };
+        let outputs = [Role::Output, Role::DiffImage, Role::AnimateOut];
+        if let (Some(i), Some(o)) = (
+            pick(&args, &[Role::Input, Role::DiffImage], &mut rng),
+            pick(&args, &outputs, &mut rng),
+        ) {
+            args[o].text = args[i].text.clone();
+        }
+    }
     let stdout = match rng.below(16) {
         0 | 1 => StdoutKind::Closed,
         2 | 3 => StdoutKind::BrokenPipe,
