@@ -599,14 +599,15 @@ fn any_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
 }
 
 /// Edits that keep each value with its flag, as often as the case is hostile: drop, repeat or
-/// swap groups, insert another command's flag, empty a value, or cut the last group short.
+/// swap groups, insert another command's flag, empty a value; and last, cut the last group
+/// short (last, so that no value slides under another flag).
 fn mutate(groups: &mut Vec<Group>, rng: &mut Rng, ctx: &Ctx) {
     for _ in 0..3 {
         if !ctx.hostile(rng) {
             continue;
         }
         let n = groups.len();
-        match rng.below(6) {
+        match rng.below(5) {
             0 if n > 0 => {
                 let i = rng.below(n);
                 if !groups[i].keep {
@@ -629,23 +630,24 @@ fn mutate(groups: &mut Vec<Group>, rng: &mut Rng, ctx: &Ctx) {
                     groups.insert(rng.below(n + 1), one);
                 }
             }
-            4 if n > 0 => {
+            _ if n > 0 => {
                 let i = rng.below(n);
                 let m = groups[i].args.len();
                 let a = &mut groups[i].args[rng.below(m)];
                 a.text = OsString::new();
                 a.path = None;
             }
-            _ => {
-                if let Some(last) = groups.last_mut()
-                    && last.args.len() > 1
-                    && !last.keep
-                {
-                    let m = 1 + rng.below(last.args.len() - 1);
-                    last.args.truncate(m);
-                }
-            }
+            _ => {}
         }
+    }
+    if ctx.hostile(rng)
+        && rng.one_in(2)
+        && let Some(last) = groups.last_mut()
+        && last.args.len() > 1
+        && !last.keep
+    {
+        let m = 1 + rng.below(last.args.len() - 1);
+        last.args.truncate(m);
     }
 }
 
