@@ -32,8 +32,8 @@
 //! - with standard output a full device, a command that prints its result does not exit 0;
 //!   nor does one with an output file on a full device.
 //!
-//! `TRACELAB_CLI_FUZZ_CASES=N` sets the number of cases (default 10,000: about 370 s of CPU
-//! for the debug build, 3 minutes on 2 idle cores); `TRACELAB_CLI_FUZZ_CASE=K` replays case K
+//! `TRACELAB_CLI_FUZZ_CASES=N` sets the number of cases (default 10,000: 300 to 370 s of CPU
+//! for the debug build, about 3 minutes on 2 idle cores); `TRACELAB_CLI_FUZZ_CASE=K` replays case K
 //! alone, printing its arguments and keeping its folder; `TRACELAB_CLI_FUZZ_VERBOSE=1` prints
 //! every case and how it ended; `TRACELAB_CLI_FUZZ_THREADS` (default 4) sets the workers and
 //! `TRACELAB_CLI_FUZZ_TIMEOUT_S` (default 20) the time limit: a case past it runs again, and is
