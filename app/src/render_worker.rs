@@ -295,10 +295,9 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
                 .as_mut()
+                && p.job.request == job.request
             {
-                if p.job.request == job.request {
-                    p.normal_gap = Some(gap);
-                }
+                p.normal_gap = Some(gap);
             }
             repaint();
         }

@@ -29,7 +29,7 @@ use tracelab_core::{
 /// One case taking longer than this is a hang (cases take well under a millisecond).
 const CASE_LIMIT_MS: u64 = 20_000;
 
-const SCENE_SEED: u64 = 0x5eed_0f_5ce_9e5;
+const SCENE_SEED: u64 = 0x5eed_0f5c_e9e5;
 const OBJ_SEED: u64 = 0x0b1_5eed_f00d;
 
 fn skip_note(msg: &str) {

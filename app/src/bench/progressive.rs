@@ -14,8 +14,13 @@ use crate::bounds::world_bounds;
 use crate::navigation::orbit;
 
 use super::{ProgressiveArgs, median};
+
 use crate::exit::check_size;
 use crate::io::load_scene;
+
+/// One timed run: time to the first coarse image, to the full image (ms), and each pass by
+/// its scale with its own time.
+type Run = (f64, f64, Vec<(u32, f64)>);
 
 /// From "the scene changed" (compile the loaded scene) to the first complete coarse pass and
 /// to the last, full-resolution pass of the progressive renderer, as the GUI drives it.
@@ -57,7 +62,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         (ends.first().map_or(full, |e| e.1), full, passes)
     };
     once(); // warm-up
-    let runs: Vec<(f64, f64, Vec<(u32, f64)>)> = (0..b.repeat.max(1)).map(|_| once()).collect();
+    let runs: Vec<Run> = (0..b.repeat.max(1)).map(|_| once()).collect();
     let coarse = median(runs.iter().map(|r| r.0).collect());
     let full = median(runs.iter().map(|r| r.1).collect());
     // Each pass by its scale: a quick coarse pass leaves out the finer ones before the full

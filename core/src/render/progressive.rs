@@ -194,7 +194,7 @@ impl TilePass {
         // Tile corners are multiples of every scale, so the coarser grid is every ratio-th
         // point of this one; `traced_before` tests that with a mask, no division per pixel.
         debug_assert!(coarser.is_none_or(|c| c % scale == 0 && ratio.is_power_of_two()));
-        debug_assert!(x0 % TILE == 0 && y0 % TILE == 0 && TILE % scale == 0);
+        debug_assert!(x0 % TILE == 0 && y0 % TILE == 0 && TILE.is_multiple_of(scale));
         TilePass {
             x0,
             y0,

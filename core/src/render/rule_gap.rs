@@ -36,11 +36,7 @@ pub fn normal_rule_gap(
 ) -> Result<NormalGap, Cancelled> {
     let (w, h) = (settings.width, settings.height);
     let rays = scene.camera.pixel_rays(w, h);
-    let similar: Vec<bool> = scene
-        .objects
-        .iter()
-        .map(|o| object_is_similitude(o))
-        .collect();
+    let similar: Vec<bool> = scene.objects.iter().map(object_is_similitude).collect();
     (0..h)
         .into_par_iter()
         .map(|row| {

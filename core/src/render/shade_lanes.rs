@@ -88,9 +88,9 @@ fn shade_packet_with(
         return out;
     }
     let shaded = kernel(&input, scene.ambient, &scene.lights, settings.shade_back);
-    for k in 0..N {
+    for (k, o) in out.iter_mut().enumerate() {
         if input.lanes & (1 << k) != 0 {
-            out[k] = (
+            *o = (
                 Vec3::new(shaded.color.x[k], shaded.color.y[k], shaded.color.z[k]),
                 Vec3::new(shaded.normal.x[k], shaded.normal.y[k], shaded.normal.z[k]),
             );
