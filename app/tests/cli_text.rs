@@ -233,7 +233,7 @@ fn with_stdout_to(device: &Path, args: &[String], dir: &Path) -> Output {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root (private device nodes): run with -- --ignored, as .ci/run does"]
 fn every_command_to_a_full_standard_output_says_so_and_exits_1() {
     let d = temp_dir("full");
     let full = mknod(&d, "full", 7);
@@ -252,7 +252,7 @@ fn every_command_to_a_full_standard_output_says_so_and_exits_1() {
 /// user sends output on purpose: not taken for a closed standard output.
 #[cfg(unix)]
 #[test]
-#[ignore = "needs root (private device nodes): run with --include-ignored, as .ci/run does"]
+#[ignore = "needs root (private device nodes): run with -- --ignored, as .ci/run does"]
 fn every_command_to_a_null_device_succeeds() {
     let d = temp_dir("null");
     let null = mknod(&d, "null", 3);
