@@ -380,9 +380,9 @@ fn diff_of_a_perfect_image_matches_and_leaves_the_students_files_alone() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{out}{}", stderr(&o));
     for want in [
-        "colour mine.png: 100.00% of 2000 pixels",
-        "normals n.png: 100.00%",
-        "depth d.png: 100.00%",
+        "colour mine.png: 0 of 2,000 pixels off by more than 2/255 (0.00%; the limit is < 1%)",
+        "normals n.png: 0 of 2,000 pixels off",
+        "depth d.png: 0 of 2,000 pixels off",
         "matches",
     ] {
         assert!(out.contains(want), "{want} missing:\n{out}");
@@ -428,31 +428,44 @@ fn diff_of_a_slightly_wrong_image_names_the_wrong_pixels_and_still_matches() {
         p[0] = if p[0] >= by { p[0] - by } else { p[0] + by };
     }
     img.save(dir.join("mine.png")).expect("save");
-    let o = diff(&dir, "mine.png", &line, &["--worst", "3"]);
+    let o = diff(&dir, "mine.png", &line, &["--regions", "2"]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{out}");
     assert!(
-        out.contains("99.65% of 2000 pixels within 8/255 (largest difference 90)"),
+        out.contains("7 of 2,000 pixels off by more than 2/255 (0.35%; the limit is < 1%), largest difference 90: matches"),
         "{out}"
     );
-    // The worst first, then ties by row and column.
-    let listed: Vec<&str> = out.lines().filter(|l| l.starts_with("  (")).collect();
-    assert_eq!(listed.len(), 3, "{out}");
+    // Three regions, largest first (ties from the top), each told at its middle pixel.
+    assert!(out.contains("3 regions of off pixels"), "{out}");
+    let listed: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("  1. ") || l.starts_with("  2. ") || l.starts_with("  3. "))
+        .collect();
+    assert_eq!(listed.len(), 2, "{out}");
     assert!(
-        listed[0].starts_with("  (36, 21):") && listed[0].contains("off by 90"),
+        listed[0].starts_with("  1. 3 pixels in (10, 5)–(12, 5); at (11, 5):"),
         "{out}"
     );
     assert!(
-        listed[1].starts_with("  (10, 5):") && listed[2].starts_with("  (11, 5):"),
+        listed[1].starts_with("  2. 3 pixels in (30, 20)–(32, 20); at (31, 20):"),
         "{out}"
     );
-    // (36, 21) is on the red sheared sphere, centred at world x = 1.2 = (36.5/50 − ½)·5: its story says so, with t and the normal rule.
+    assert!(out.contains("… and 1 smaller region"), "{out}");
+    // (36, 21) is on the red sheared sphere, centred at world x = 1.2 = (36.5/50 − ½)·5: its
+    // story says so, with t, the normal rule and the bytes each image should hold.
+    let o = diff(&dir, "mine.png", &line, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let third = out
+        .split("  3. ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no third region:\n{out}"));
     assert!(
-        listed[0].contains("Sphere")
-            && listed[0].contains("t = ")
-            && listed[0].contains("normal by (M⁻¹)ᵀ"),
-        "{}",
-        listed[0]
+        third.starts_with("1 pixel in (36, 21)–(36, 21); at (36, 21):")
+            && third.contains("Sphere")
+            && third.contains("t = ")
+            && third.contains("normal by (M⁻¹)ᵀ")
+            && third.contains("each image there: colour ["),
+        "{third}"
     );
     let map = image::open(dir.join("mine.diff.png"))
         .expect("heat map")
@@ -482,7 +495,7 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
     let line = course_line(&scene);
     let args: Vec<&str> = line.iter().map(String::as_str).collect();
     assert!(tracelab(&args, &dir).status.success());
-    // The incorrect normal rule: the classic wrong image.
+    // The incorrect normal rule: the classic wrong images, colour and normals.
     let s = scene.to_str().expect("utf-8");
     let o = tracelab(
         &[
@@ -493,6 +506,12 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
             "40",
             "-output",
             "wrong.png",
+            "-normals",
+            "n.png",
+            "-depth",
+            "8",
+            "11",
+            "d.png",
             "-normal_transform",
             "incorrect",
         ],
@@ -507,8 +526,10 @@ fn diff_of_a_wrong_image_or_a_wrong_size_does_not_match() {
         "{out}"
     );
     assert!(
-        out.contains("from the other rule's"),
-        "the worst pixels are where the rules part:\n{out}"
+        out.starts_with(
+            "diagnosis: your images match tracelab's render with one known mistake: normals transformed by M instead of (M⁻¹)ᵀ (normal-by-m)\n"
+        ),
+        "the mistake is named first:\n{out}"
     );
     // Wrong size: said with both sizes, before any pixel.
     let o = tracelab(
@@ -579,8 +600,12 @@ fn diff_accepts_the_courses_own_reference_images() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{out}");
     assert!(
-        out.contains("colour output2_16.png: 100.00%")
-            || out.contains("colour output2_16.png: 99."),
+        out.contains("colour output2_16.png: 0 of 40,000 pixels off"),
+        "{out}"
+    );
+    // The depth alone is wrong, and named for it.
+    assert!(
+        out.starts_with("diagnosis: your images match tracelab's render with one known mistake: the object-space ray direction normalised, but t not rescaled to world space (depth-not-rescaled)"),
         "{out}"
     );
     assert!(

@@ -1,19 +1,22 @@
 //! `tracelab diff IMAGE -- COURSE-COMMAND-LINE`: a student's image against tracelab's
-//! reference for the same course command line — the size first, then every pixel within a
-//! tolerance as the course's graders allow, a heat map, and for the worst pixels the one-line
-//! story of what the reference ray hit. Normal and depth images named on the line are
-//! compared the same way. Nothing the command line names is written: those are the
-//! student's files.
+//! reference for the same course command line — the size first, then every pixel by the
+//! references' own criterion (`judge`), a heat map, the known mistake the images match
+//! (`diagnose`), and the off pixels as regions (`regions`), each with the story of what the
+//! reference ray hit there. Normal and depth images named on the line are compared the same
+//! way. Nothing the command line names is written: those are the student's files.
 
 use std::ffi::OsString;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use image::RgbImage;
-use tracelab_core::render::inspect_pixel;
+use tracelab_core::render::{depth_shade, inspect_pixel, quantize};
 use tracelab_core::{CompiledScene, Frame, RenderSettings, Scene, View};
 
 use super::course::parse_course_args;
+use super::diagnose::{Judged, diagnose, diagnosis_text};
+use super::judge::{Criterion, compare, count, difference};
+use super::regions::regions;
 use super::render::{RenderJob, render_with_progress};
 use crate::exit::{Exit, check_size, usage};
 use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout_text};
@@ -23,15 +26,24 @@ use crate::story::{one_line, pixel_report};
 pub const LONG_ABOUT: &str = "Compare your ray tracer's image with tracelab's reference for the same course \
     command line, e.g.\n  tracelab diff mine.png -- -input scene2_11_squashed_sphere.txt -size 200 200 -output x.png\n\n\
     The reference is rendered for that line (nothing it names is written). The sizes must agree; \
-    then a pixel matches when no channel differs by more than --tolerance (of 255), and the image \
-    matches when at least --min-match percent of its pixels do (the course's graders allow a few \
-    pixels on silhouettes). A heat map is written beside IMAGE (IMAGE.diff.png): matching pixels as \
-    dim grey, the others from red (just over) to yellow (far off). The heat map never replaces a file \
-    named on the command line, a symbolic link or anything but a regular file: then it is written as \
-    IMAGE.diff-2.png (or -3, ...), and the verdict says so. For the worst pixels the one-line \
-    story of the reference ray is printed: what it hit, at which t, with which normal. When the line \
-    names -normals or -depth files, those files (your program's outputs) are compared with the \
-    reference's too.\n\n\
+    then images are judged as the course's reference images were made: a pixel is off when a \
+    channel differs by more than 2/255 (--tolerance), and an image matches when fewer than 1% of \
+    its pixels are off (--min-match 99: fewer than 100 − 99 percent; 100: none). The verdict gives \
+    the count: \"412 of 40,000 pixels off by more than 2/255 (1.03%; the limit is < 1%)\".\n\n\
+    When an image does not match, diff renders the known mistakes that change this picture \
+    (pixel corners instead of centres, normals by M, t not rescaled, back faces lit, ambient \
+    not times the diffuse colour, rows flipped, ... 17 in all) and says first which one your \
+    images match by the same criterion, or which pair, with the course's rule it breaks and how \
+    many of the off pixels it explains; or that none does. Then the off pixels of each image as \
+    connected regions, largest first (--regions N of them), with their size and bounding box, \
+    one-pixel fringes along silhouettes marked as such, and the story of each region's typical \
+    pixel: what the reference ray hit, at which t, with which normal, the bytes each image \
+    should hold there, and what your byte implies (the t your depth byte encodes).\n\n\
+    A heat map is written beside IMAGE (IMAGE.diff.png): pixels not off as dim grey, the others \
+    from red (just over) to yellow (far off). The heat map never replaces a file named on the \
+    command line, a symbolic link or anything but a regular file: then it is written as \
+    IMAGE.diff-2.png (or -3, ...), and the verdict says so. When the line names -normals or \
+    -depth files, those files (your program's outputs) are compared with the reference's too.\n\n\
     Pixel coordinates are x from the left, row from the top (as in tracelab inspect).\n\
     Exit status: 0 when every image matches, 3 when one does not, 4 when every image matches but a \
     heat map could not be written, 5 when one does not match and a heat map could not be written \
@@ -41,15 +53,16 @@ pub const LONG_ABOUT: &str = "Compare your ray tracer's image with tracelab's re
 pub struct DiffArgs {
     /// Your colour image (.png .tga .ppm .bmp).
     pub image: PathBuf,
-    /// The largest channel difference (of 255) that still counts as matching.
-    #[arg(long, default_value_t = 8)]
+    /// The largest channel difference (of 255) that is not off: the references' own is 2.
+    #[arg(long, default_value_t = Criterion::REFERENCES.tolerance)]
     pub tolerance: u8,
-    /// The percentage of matching pixels an image needs.
-    #[arg(long, default_value_t = 99.0)]
+    /// The percentage of pixels that must not be off: fewer than (100 − this)% may be (the
+    /// references' own: 99, so fewer than 1%).
+    #[arg(long, default_value_t = Criterion::REFERENCES.min_match)]
     pub min_match: f64,
-    /// How many of the worst pixels to explain.
-    #[arg(long, default_value_t = 5)]
-    pub worst: usize,
+    /// How many regions of off pixels to explain, largest first.
+    #[arg(long, visible_alias = "worst", default_value_t = 5)]
+    pub regions: usize,
     /// The course's command line, after `--`: -input F -size W H -output F [-normals F] [-depth MIN MAX F] ...
     #[arg(
         last = true,
@@ -60,63 +73,13 @@ pub struct DiffArgs {
     pub course: Vec<OsString>,
 }
 
-/// How one image compares with its reference.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Comparison {
-    pub within: usize,
-    pub total: usize,
-    pub max_difference: u8,
-    /// (largest channel difference, x, row), largest first, ties by position.
-    pub worst: Vec<(u8, u32, u32)>,
-}
-
-impl Comparison {
-    pub fn percent(&self) -> f64 {
-        if self.total == 0 {
-            100.0
-        } else {
-            100.0 * self.within as f64 / self.total as f64
-        }
-    }
-}
-
-/// Per-pixel comparison of two images of the same size.
-pub fn compare(
-    mine: &RgbImage,
-    reference: &RgbImage,
-    tolerance: u8,
-    keep_worst: usize,
-) -> Comparison {
-    let mut within = 0;
-    let mut max_difference = 0;
-    let mut off = Vec::new();
-    for (x, row, p) in mine.enumerate_pixels() {
-        let q = reference.get_pixel(x, row);
-        let d = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
-        max_difference = max_difference.max(d);
-        if d <= tolerance {
-            within += 1;
-        } else {
-            off.push((d, x, row));
-        }
-    }
-    off.sort_by(|a, b| b.0.cmp(&a.0).then((a.2, a.1).cmp(&(b.2, b.1))));
-    off.truncate(keep_worst);
-    Comparison {
-        within,
-        total: (mine.width() * mine.height()) as usize,
-        max_difference,
-        worst: off,
-    }
-}
-
-/// The heat map: matching pixels as the reference dimmed to a quarter in grey, the others
+/// The heat map: pixels not off as the reference dimmed to a quarter in grey, the others
 /// from red (just over the tolerance) to yellow (255 apart).
 pub fn heat_map(mine: &RgbImage, reference: &RgbImage, tolerance: u8) -> RgbImage {
     RgbImage::from_fn(reference.width(), reference.height(), |x, row| {
         let q = reference.get_pixel(x, row);
         let p = mine.get_pixel(x, row);
-        let d = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
+        let d = difference(&p.0, &q.0);
         if d <= tolerance {
             let lum = (u32::from(q[0]) * 3 + u32::from(q[1]) * 6 + u32::from(q[2])) / 10;
             let g = (lum / 4) as u8;
@@ -253,17 +216,26 @@ struct Reference<'a> {
     frame: &'a Frame,
 }
 
+/// One of the student's images of the right size, decoded, with the reference's bytes and
+/// the verdict.
+struct Decoded<'s> {
+    student: &'s Student<'s>,
+    mine: RgbImage,
+    reference: Vec<u8>,
+    ok: bool,
+}
+
 /// Compares one of the student's images with one view of the reference, printing the
-/// verdict and the worst pixels. Returns whether it matches; a heat map that could not be
-/// written is said in the verdict and its reason pushed on `failed`.
-fn check(
-    a: &DiffArgs,
+/// verdict. Returns the decoded image (`None` for a wrong size, which does not match); a heat
+/// map that could not be written is said in the verdict and its reason pushed on `failed`.
+fn check<'s>(
+    c: &Criterion,
     r: &Reference,
-    s: &Student,
+    s: &'s Student<'s>,
     plan: &mut OutputPlan,
     out: &mut String,
     failed: &mut Vec<String>,
-) -> anyhow::Result<bool> {
+) -> anyhow::Result<Option<Decoded<'s>>> {
     let (w, h) = (r.frame.width, r.frame.height);
     if s.size != (w, h) {
         out.push_str(&format!(
@@ -273,14 +245,14 @@ fn check(
             s.size.0,
             s.size.1
         ));
-        return Ok(false);
+        return Ok(None);
     }
     let mine = decode(s, (w, h))?;
     let reference = RgbImage::from_raw(w, h, r.frame.rgb8(s.view, s.depth))
         .ok_or_else(|| anyhow::anyhow!("reference image has the wrong size"))?;
-    let c = compare(&mine, &reference, a.tolerance, a.worst);
-    let ok = c.percent() >= a.min_match;
-    let map = match write_heat_map(&heat_map(&mine, &reference, a.tolerance), s.path, plan) {
+    let cmp = compare(&mine, &reference, c.tolerance);
+    let ok = c.matches(cmp.off, cmp.total);
+    let map = match write_heat_map(&heat_map(&mine, &reference, c.tolerance), s.path, plan) {
         Ok(Implicit {
             path,
             instead_of: None,
@@ -299,26 +271,139 @@ fn check(
         }
     };
     out.push_str(&format!(
-        "{} {}: {:.2}% of {} pixels within {}/255 (largest difference {}): {}; {map}\n",
+        "{} {}: {} of {} pixels off by more than {}/255 ({:.2}%; the limit is {}), largest difference {}: {}; {map}\n",
         s.what,
         s.path.display(),
-        c.percent(),
-        c.total,
-        a.tolerance,
-        c.max_difference,
+        count(cmp.off),
+        count(cmp.total),
+        c.tolerance,
+        cmp.percent_off(),
+        c.limit(),
+        cmp.max_difference,
         if ok { "matches" } else { "does not match" },
     ));
-    for &(d, x, row) in &c.worst {
+    Ok(Some(Decoded {
+        student: s,
+        mine,
+        reference: reference.into_raw(),
+        ok,
+    }))
+}
+
+/// The t a depth byte `g` encodes: shade in [g/255, (g+1)/255), so t in (t_lo, t_hi].
+fn t_of_depth_byte(g: u8, (min, max): (f32, f32)) -> (f64, f64) {
+    let (min, max) = (f64::from(min), f64::from(max));
+    let t = |shade: f64| max - shade * (max - min);
+    (t((f64::from(g) + 1.0) / 255.0), t(f64::from(g) / 255.0))
+}
+
+/// What the student's byte at a pixel implies, where it says something in the course's terms.
+fn implied(d: &Decoded, p: [u8; 3], r: &Reference) -> String {
+    match d.student.view {
+        View::Depth if p[0] == 0 => "; your byte 0 is the background or t ≥ max".to_string(),
+        View::Depth if p[0] == 255 => "; your byte 255 means t ≤ min".to_string(),
+        View::Depth => {
+            let (lo, hi) = t_of_depth_byte(p[0], d.student.depth);
+            format!("; your byte {} means t in ({lo:.4}, {hi:.4}]", p[0])
+        }
+        View::Normals => format!(
+            "; yours means |n| ≈ ({:.3}, {:.3}, {:.3})",
+            f32::from(p[0]) / 255.0,
+            f32::from(p[1]) / 255.0,
+            f32::from(p[2]) / 255.0
+        ),
+        View::Color if p == quantize3(r.compiled.background) => {
+            "; yours is the background colour: your ray seems to miss".to_string()
+        }
+        View::Color => String::new(),
+    }
+}
+
+fn quantize3(c: glam::Vec3) -> [u8; 3] {
+    [quantize(c.x), quantize(c.y), quantize(c.z)]
+}
+
+/// The bytes each image of the line should hold at pixel `i`.
+fn expected_bytes(r: &Reference, students: &[Student], x: u32, row: u32) -> String {
+    let Some(s) = r.frame.get(x, row) else {
+        return String::new();
+    };
+    let mut parts = vec![format!("colour {:?}", s.color)];
+    for st in students {
+        match st.view {
+            View::Normals => parts.push(format!("normals {:?}", s.normal)),
+            View::Depth => {
+                let g = if s.is_hit() {
+                    quantize(depth_shade(s.t, st.depth.0, st.depth.1))
+                } else {
+                    0
+                };
+                parts.push(format!("depth {:?}", [g; 3]));
+            }
+            View::Color => {}
+        }
+    }
+    parts.join(", ")
+}
+
+/// Each image's regions of off pixels, largest first, with the story at the typical pixel.
+fn region_text(
+    d: &Decoded,
+    r: &Reference,
+    students: &[Student],
+    c: &Criterion,
+    keep: usize,
+) -> String {
+    let (w, h) = (r.frame.width, r.frame.height);
+    let nodes: Vec<u32> = r.frame.samples.iter().map(|s| s.node).collect();
+    let all = regions(d.mine.as_raw(), &d.reference, &nodes, (w, h), c.tolerance);
+    if all.is_empty() {
+        return String::new();
+    }
+    let fringes = all.iter().filter(|g| g.fringe).count();
+    let mut out = format!(
+        "{} {}: {} region{} of off pixels ({} of them one-pixel fringes along silhouettes), largest first:\n",
+        d.student.what,
+        d.student.path.display(),
+        count(all.len()),
+        if all.len() == 1 { "" } else { "s" },
+        count(fringes)
+    );
+    for (k, g) in all.iter().take(keep).enumerate() {
+        let (x, row) = g.typical;
+        let i = (row * w + x) as usize * 3;
+        let p = [
+            d.mine.as_raw()[i],
+            d.mine.as_raw()[i + 1],
+            d.mine.as_raw()[i + 2],
+        ];
+        let q = [d.reference[i], d.reference[i + 1], d.reference[i + 2]];
         let story = inspect_pixel(r.scene, r.compiled, &r.settings, x, row);
         let report = pixel_report(r.scene, &story, &r.settings);
+        let (x0, y0, x1, y1) = g.bounds;
         out.push_str(&format!(
-            "  ({x}, {row}): yours {:?}, reference {:?} (off by {d}): {}\n",
-            mine.get_pixel(x, row).0,
-            reference.get_pixel(x, row).0,
-            one_line(&report)
+            "  {}. {} pixel{} in ({x0}, {y0})–({x1}, {y1}){}; at ({x}, {row}): yours {p:?}, reference {q:?}{}\n     the reference ray: {}\n     each image there: {}\n",
+            k + 1,
+            count(g.pixels),
+            if g.pixels == 1 { "" } else { "s" },
+            if g.fringe {
+                ", a one-pixel fringe along a silhouette (where the edge is sampled)"
+            } else {
+                ""
+            },
+            implied(d, p, r),
+            one_line(&report),
+            expected_bytes(r, students, x, row),
         ));
     }
-    Ok(ok)
+    if all.len() > keep {
+        out.push_str(&format!(
+            "  … and {} smaller region{} (--regions N lists more)\n",
+            count(all.len() - keep),
+            if all.len() - keep == 1 { "" } else { "s" }
+        ));
+    }
+    out
 }
 
 pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
@@ -328,6 +413,10 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
             a.min_match
         )));
     }
+    let criterion = Criterion {
+        tolerance: a.tolerance,
+        min_match: a.min_match,
+    };
     let job: RenderJob = parse_course_args(&a.course)?;
     check_size(job.width, job.height)?;
     let size = (job.width, job.height);
@@ -371,11 +460,34 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         settings,
         frame: &frame,
     };
-    let mut out = String::new();
+    let mut verdicts = String::new();
     let mut failed = Vec::new();
     let mut all = true;
+    let mut decoded = Vec::new();
     for s in &students {
-        all &= check(a, &r, s, &mut plan, &mut out, &mut failed)?;
+        let d = check(&criterion, &r, s, &mut plan, &mut verdicts, &mut failed)?;
+        all &= d.as_ref().is_some_and(|d| d.ok);
+        decoded.extend(d);
+    }
+    let mut out = String::new();
+    if !all && !decoded.is_empty() {
+        // The mistake first: it says more than any pixel.
+        let judged: Vec<Judged> = decoded
+            .iter()
+            .map(|d| Judged {
+                what: d.student.what,
+                view: d.student.view,
+                depth: d.student.depth,
+                mine: d.mine.as_raw(),
+                reference: &d.reference,
+            })
+            .collect();
+        let found = diagnose(&scene, &compiled, &settings, &judged, &criterion);
+        out.push_str(&diagnosis_text(&found, &judged));
+    }
+    out.push_str(&verdicts);
+    for d in &decoded {
+        out.push_str(&region_text(d, &r, &students, &criterion, a.regions));
     }
     // Paths and node labels (an `obj_file` name) are the user's text: escaped.
     write_stdout_text(&out)?;
@@ -398,17 +510,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn compare_counts_pixels_over_the_tolerance_and_sorts_the_worst() {
+    fn the_heat_map_marks_pixels_past_the_tolerance() {
         let reference = RgbImage::from_pixel(4, 3, image::Rgb([100, 100, 100]));
         let mut mine = reference.clone();
-        mine.put_pixel(1, 2, image::Rgb([100, 109, 100])); // 9 over
         mine.put_pixel(3, 0, image::Rgb([60, 100, 100])); // 40 over
-        mine.put_pixel(0, 0, image::Rgb([108, 92, 100])); // 8: within
-        let c = compare(&mine, &reference, 8, 5);
-        assert_eq!((c.within, c.total, c.max_difference), (10, 12, 40));
-        assert_eq!(c.worst, [(40, 3, 0), (9, 1, 2)]);
-        let map = heat_map(&mine, &reference, 8);
+        mine.put_pixel(0, 0, image::Rgb([102, 98, 100])); // 2: not off
+        let map = heat_map(&mine, &reference, 2);
         assert_eq!(map.get_pixel(3, 0).0, [255, 40, 0]);
         assert_eq!(map.get_pixel(0, 0).0, [25, 25, 25]);
+    }
+
+    #[test]
+    fn a_depth_byte_encodes_a_range_of_t() {
+        // Range 8..11: byte 255 is t ≤ 8 + 3/255; byte 0 is t > 11 − 3/255.
+        let (lo, hi) = t_of_depth_byte(85, (8.0, 11.0));
+        assert!((hi - 10.0).abs() < 1e-9 && (lo - (10.0 - 3.0 / 255.0)).abs() < 1e-9);
     }
 }

@@ -7,11 +7,14 @@
 
 mod animate;
 mod course;
+mod diagnose;
 mod diff;
 mod fmt;
 mod inspect;
+mod judge;
 mod mistyped;
 mod progress;
+mod regions;
 mod render;
 mod values;
 
@@ -56,7 +59,7 @@ pub enum Command {
     Render(RenderArgs),
     /// Sweep one number of a Transform op over N frames: a PNG sequence and an animated PNG.
     Animate(animate::AnimateArgs),
-    /// Compare your image with the reference for a course command line (after --): heat map, worst pixels.
+    /// Compare your image with the reference for a course command line (after --): verdict, the mistake it matches, regions, heat map.
     #[command(long_about = diff::LONG_ABOUT)]
     Diff(diff::DiffArgs),
     /// One pixel's story: ray, path with M / M⁻¹ / (M⁻¹)ᵀ, t, normals, shading (rows from the top).

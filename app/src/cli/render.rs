@@ -179,6 +179,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         shade_back: job.shade_back,
         normal_transform: job.normal_transform,
         object_rays: job.object_rays,
+        variant: None,
     };
     let frame = render_with_progress(&compiled, &settings)?;
     let save = |view: View, depth: (f32, f32), path: &Path| {

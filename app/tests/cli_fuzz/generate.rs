@@ -474,7 +474,12 @@ fn diff_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
     }
     if rng.one_in(3) {
         let v = ctx.pick(rng, "0|1|5", "18446744073709551615|18446744073709551616|-1");
-        g.push(group(vec![plain("--worst"), plain(v)]));
+        let flag = if rng.one_in(2) {
+            "--worst"
+        } else {
+            "--regions"
+        };
+        g.push(group(vec![plain(flag), plain(v)]));
     }
     g
 }

@@ -8,6 +8,7 @@ mod cull;
 mod frame;
 mod inspect;
 mod limits;
+pub mod mistakes;
 mod object_rays;
 mod progressive;
 mod rule_gap;
@@ -20,6 +21,7 @@ pub use compile::{CompiledScene, Hit, Object, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
+pub use mistakes::{Mistake, Variant};
 pub use object_rays::{ObjectRays, ObjectT};
 pub use progressive::{
     Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced,
@@ -64,6 +66,9 @@ pub struct RenderSettings {
     /// How rays are moved into object space, and which t is kept (the lecture's "what to do
     /// about the depth t").
     pub object_rays: ObjectRays,
+    /// A known student mistake (or two) to render instead of the course's image, for
+    /// `tracelab diff`'s diagnosis; `None` is the course's render.
+    pub variant: Option<Variant>,
 }
 
 impl RenderSettings {
@@ -74,6 +79,7 @@ impl RenderSettings {
             shade_back: false,
             normal_transform: NormalTransform::Correct,
             object_rays: ObjectRays::Unnormalized,
+            variant: None,
         }
     }
 }

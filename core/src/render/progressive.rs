@@ -515,6 +515,19 @@ fn render_scales(
 ) -> Result<(), Cancelled> {
     let start = Instant::now();
     let (w, h) = (settings.width, settings.height);
+    if settings.variant.is_some() {
+        // A mistake's picture (diff's diagnosis): one plain pass, nothing of the fast path.
+        let frame = super::mistakes::render_variant(scene, settings);
+        *target.lock() = frame;
+        target.bump();
+        on_pass(PassInfo {
+            pass: 0,
+            passes: 1,
+            scale: 1,
+            elapsed: start.elapsed(),
+        });
+        return Ok(());
+    }
     {
         let mut f = target.lock();
         if f.width != w || f.height != h {

@@ -591,6 +591,7 @@ impl Viewport {
             shade_back: s.shade_back,
             normal_transform: s.normal_transform,
             object_rays: s.object_rays,
+            variant: None,
         }
     }
 }
