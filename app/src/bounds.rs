@@ -2,7 +2,7 @@
 //! above a node and the world box of a node's objects, for framing and for the gizmo.
 
 use glam::{DMat4, Mat4, Vec3};
-use tracelab_core::scene::validate::compose_f64;
+use tracelab_core::scene::compose_f64;
 use tracelab_core::{NodeId, NodeKind, Scene};
 
 /// World from the space `node` itself sits in: the product of every Transform above it

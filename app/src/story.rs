@@ -520,7 +520,7 @@ pub fn node_similitudes(
     id: tracelab_core::NodeId,
 ) -> (Option<SimilitudeTest>, SimilitudeTest) {
     use tracelab_core::NodeKind;
-    use tracelab_core::scene::validate::compose_f64;
+    use tracelab_core::scene::compose_f64;
     let g = &scene.graph;
     let mut chain = DMat4::IDENTITY;
     for p in g.path_to(id).unwrap_or_default() {

@@ -344,7 +344,7 @@ impl Orbit {
 mod tests {
     use super::*;
     use tracelab_core::render::inspect_pixel;
-    use tracelab_core::scene::validate::compose_f64;
+    use tracelab_core::scene::compose_f64;
     use tracelab_core::{CompiledScene, MeshCache, RenderSettings, parse_scene};
 
     /// The composed world-from-object matrix of the node a story hit, from its path (f64).

@@ -16,7 +16,7 @@ use crate::geometry::{
     intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
 };
 use crate::memory::{OutOfMemory, try_with_capacity};
-use crate::scene::validate::compose_f64;
+use crate::scene::compose_f64;
 use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
 
 #[derive(Clone, Debug)]

@@ -16,7 +16,7 @@ use crate::accel::TriangleHit;
 use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots,
 };
-use crate::scene::validate::compose_f64;
+use crate::scene::compose_f64;
 use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
 
 /// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low

@@ -8,7 +8,7 @@ use super::compile::CompiledScene;
 use super::shade::{ShadeInfo, shade_hit};
 use super::{NormalTransform, ObjectRays, RenderSettings};
 use crate::geometry::Ray;
-use crate::scene::validate::compose_f64;
+use crate::scene::compose_f64;
 use crate::scene::{NodeId, NodeKind, Scene};
 
 /// One node on the way from the root to the object hit.

@@ -11,8 +11,8 @@ pub mod validate;
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
-pub use transform::{TransformOp, compose};
-pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene, unit};
+pub use transform::{TransformOp, compose, compose_f64, op_matrix_f64, unit};
+pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene};
 
 use glam::Vec3;
 

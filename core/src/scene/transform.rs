@@ -1,6 +1,7 @@
-//! Transform ops as the scene format lists them, and their composition.
+//! Transform ops as the scene format lists them, and their composition (in f64, so long
+//! chains keep their precision).
 
-use glam::{Mat4, Vec3};
+use glam::{DMat4, DVec3, Mat4, Vec3};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum TransformOp {
@@ -31,7 +32,7 @@ impl TransformOp {
             TransformOp::Rotate { axis, degrees } => {
                 // A deliberate difference from the course parser: the axis is normalised, so
                 // `Rotate { 0 0 2 90 }` is a rotation, not a rotation and a scale.
-                let axis = super::validate::unit(axis).unwrap_or(Vec3::Z);
+                let axis = unit(axis).unwrap_or(Vec3::Z);
                 Mat4::from_axis_angle(axis, degrees.to_radians())
             }
             TransformOp::Matrix(m) => m,
@@ -83,7 +84,43 @@ impl TransformOp {
 /// position like every other op.) Composed in f64 and rounded once, so long chains keep
 /// their precision.
 pub fn compose(ops: &[TransformOp]) -> Mat4 {
-    super::validate::compose_f64(ops).as_mat4()
+    compose_f64(ops).as_mat4()
+}
+
+/// M = op1 · op2 · … · opn in f64.
+pub fn compose_f64(ops: &[TransformOp]) -> DMat4 {
+    ops.iter()
+        .fold(DMat4::IDENTITY, |m, op| m * op_matrix_f64(op))
+}
+
+/// An op's matrix in f64, so long chains compose without losing precision.
+pub fn op_matrix_f64(op: &TransformOp) -> DMat4 {
+    let d = |v: Vec3| v.as_dvec3();
+    match *op {
+        TransformOp::Scale(s) => DMat4::from_scale(d(s)),
+        TransformOp::UniformScale(s) => DMat4::from_scale(DVec3::splat(f64::from(s))),
+        TransformOp::Translate(t) => DMat4::from_translation(d(t)),
+        TransformOp::XRotate(a) => DMat4::from_rotation_x(f64::from(a).to_radians()),
+        TransformOp::YRotate(a) => DMat4::from_rotation_y(f64::from(a).to_radians()),
+        TransformOp::ZRotate(a) => DMat4::from_rotation_z(f64::from(a).to_radians()),
+        TransformOp::Rotate { axis, degrees } => {
+            // Normalised in f64 after the overflow-safe f32 step, so `0 0 1e20` is z.
+            let axis = unit(axis).unwrap_or(Vec3::Z).as_dvec3().normalize();
+            DMat4::from_axis_angle(axis, f64::from(degrees).to_radians())
+        }
+        TransformOp::Matrix(m) => m.as_dmat4(),
+    }
+}
+
+/// `v` at unit length, or `None` for a zero or non-finite vector. Divides by the largest
+/// component first, so vectors whose squared length overflows f32 (`0 0 1e20`) still
+/// normalise to what their direction says.
+pub fn unit(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    if !(m.is_finite() && m > 0.0) {
+        return None;
+    }
+    (v / m).try_normalize()
 }
 
 #[cfg(test)]

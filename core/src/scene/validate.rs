@@ -2,8 +2,9 @@
 //! the editor checks every edit with them before applying it, and the checked writer before
 //! it writes. A scene that passes them is one the writer can print and the parser read back.
 
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use glam::{DMat3, DMat4, Vec3};
 
+use super::transform::{compose_f64, op_matrix_f64, unit};
 use super::{Background, Camera, Graph, Light, Material, NodeId, NodeKind, Scene, TransformOp};
 
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
@@ -75,17 +76,6 @@ impl std::fmt::Display for Problem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.message)
     }
-}
-
-/// `v` at unit length, or `None` for a zero or non-finite vector. Divides by the largest
-/// component first, so vectors whose squared length overflows f32 (`0 0 1e20`) still
-/// normalise to what their direction says.
-pub fn unit(v: Vec3) -> Option<Vec3> {
-    let m = v.abs().max_element();
-    if !(m.is_finite() && m > 0.0) {
-        return None;
-    }
-    (v / m).try_normalize()
 }
 
 /// The largest ratio of stretch to squash a linear map may have. f32 keeps about 7 digits;
@@ -290,31 +280,6 @@ pub fn check_op(op: &TransformOp) -> Result<(), Invalid> {
         ));
     }
     Ok(())
-}
-
-/// An op's matrix in f64, so long chains compose without losing precision.
-pub fn op_matrix_f64(op: &TransformOp) -> DMat4 {
-    let d = |v: Vec3| v.as_dvec3();
-    match *op {
-        TransformOp::Scale(s) => DMat4::from_scale(d(s)),
-        TransformOp::UniformScale(s) => DMat4::from_scale(DVec3::splat(f64::from(s))),
-        TransformOp::Translate(t) => DMat4::from_translation(d(t)),
-        TransformOp::XRotate(a) => DMat4::from_rotation_x(f64::from(a).to_radians()),
-        TransformOp::YRotate(a) => DMat4::from_rotation_y(f64::from(a).to_radians()),
-        TransformOp::ZRotate(a) => DMat4::from_rotation_z(f64::from(a).to_radians()),
-        TransformOp::Rotate { axis, degrees } => {
-            // Normalised in f64 after the overflow-safe f32 step, so `0 0 1e20` is z.
-            let axis = unit(axis).unwrap_or(Vec3::Z).as_dvec3().normalize();
-            DMat4::from_axis_angle(axis, f64::from(degrees).to_radians())
-        }
-        TransformOp::Matrix(m) => m.as_dmat4(),
-    }
-}
-
-/// M = op1 · op2 · … · opn in f64.
-pub fn compose_f64(ops: &[TransformOp]) -> DMat4 {
-    ops.iter()
-        .fold(DMat4::IDENTITY, |m, op| m * op_matrix_f64(op))
 }
 
 /// A world-from-object matrix, composed through a chain of Transforms, that rays cannot be

@@ -1,0 +1,380 @@
+//! Recursive-descent reader for the 6.837 scene format. The object tree is parsed with an
+//! explicit stack (no recursion), so nesting depth is limited only by memory. Errors are
+//! collected, not thrown: after an error the parser skips to the end of the enclosing block
+//! and carries on, so one pass reports as many problems as it can.
+//!
+//! In parts: `reader.rs` (tokens, comments and messages), `fields.rs` (a flat block's
+//! `name value…` lines), `blocks.rs` (the top level: camera, lights, background,
+//! materials), `objects.rs` (the object tree and Transform ops); this file holds the
+//! parser's state, its entry points and the checks once the whole file is read.
+
+mod blocks;
+mod fields;
+mod objects;
+mod reader;
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
+use super::token_stream::TokenStream;
+
+use crate::scene::{
+    Background, Camera, CsgOp, Graph, Light, Material, NodeId, NodeKind, Scene, SceneComments,
+    validate,
+};
+
+/// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
+/// completely; it may still come with errors that concern single nodes (an OBJ file that
+/// could not be loaded), which `diagnostics.has_errors()` reports.
+///
+/// Parsing never touches the file system: TriangleMesh nodes come back
+/// [`MeshSlot::Unresolved`], listed in `meshes`, until [`super::resolve_meshes`] loads them.
+#[derive(Debug)]
+pub struct ParseOutcome {
+    pub scene: Option<Scene>,
+    pub diagnostics: Diagnostics,
+    /// Comments that stand where the scene cannot keep them (between a keyword and its
+    /// value): writing the scene drops them. Each is also among `diagnostics` as a warning;
+    /// kept apart so a save can repeat them (see [`ParseOutcome::lost_comments`]).
+    pub lost_comments: Vec<Diagnostic>,
+    /// Each TriangleMesh node still to be loaded, with where its file name stands.
+    pub meshes: Vec<MeshRef>,
+    /// The diagnostics counted but not shown (the last `summaries` of `diagnostics` say so),
+    /// for the resolve step to go on counting within the same cap.
+    pub(crate) unshown: UnshownSummary,
+}
+
+/// Errors and warnings left out after the first [`MAX_SHOWN`] of each, and where the first
+/// of them stands.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct UnshownSummary {
+    pub errors: (usize, Option<Located>),
+    pub warnings: (usize, Option<Located>),
+    /// How many "… and N more" lines end `diagnostics`.
+    pub summaries: usize,
+}
+
+impl ParseOutcome {
+    /// The scene if there was no error at all, else every diagnostic.
+    pub fn into_result(self) -> Result<(Scene, Diagnostics), Diagnostics> {
+        match self.scene {
+            Some(s) if !self.diagnostics.has_errors() => Ok((s, self.diagnostics)),
+            _ => Err(self.diagnostics),
+        }
+    }
+
+    /// Comments that writing the scene would drop, as warnings with file:line:col.
+    pub fn lost_comments(&self) -> &[Diagnostic] {
+        &self.lost_comments
+    }
+}
+
+/// The largest scene file read. Scenes are hand-written or generated text (meshes live in OBJ
+/// files); the cap keeps a device, a FIFO or a mistaken huge file from filling memory.
+pub const MAX_SCENE_BYTES: usize = 64 << 20;
+
+/// Reads and parses a scene file without loading its meshes (what `tracelab fmt` needs: it
+/// works when an OBJ file is missing).
+pub fn load_scene_unresolved(path: &Path) -> ParseOutcome {
+    let name = path.display().to_string();
+    let whole_file_error = |message: String| ParseOutcome {
+        scene: None,
+        diagnostics: Diagnostics(vec![Diagnostic {
+            severity: Severity::Error,
+            file: name.clone(),
+            line: 0,
+            col: 0,
+            message,
+        }]),
+        lost_comments: Vec::new(),
+        meshes: Vec::new(),
+        unshown: UnshownSummary::default(),
+    };
+    match read_capped(path, MAX_SCENE_BYTES) {
+        Ok(Some(bytes)) => parse_scene_unresolved(&bytes, &name),
+        Ok(None) => whole_file_error(format!(
+            "the file is larger than {} MiB, the most tracelab reads as a scene",
+            MAX_SCENE_BYTES >> 20
+        )),
+        Err(e) => whole_file_error(format!("cannot read scene file: {e}")),
+    }
+}
+
+/// The file's bytes, or None when it holds more than `cap`. Reads at most `cap + 1` bytes, so
+/// a character device or a FIFO that never ends cannot be read forever.
+pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec<u8>>> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path)?;
+    let hint = file.metadata().map_or(0, |m| m.len()).min(cap as u64 + 1) as usize;
+    let mut bytes = Vec::with_capacity(hint);
+    file.take(cap as u64 + 1).read_to_end(&mut bytes)?;
+    Ok((bytes.len() <= cap).then_some(bytes))
+}
+
+/// Parses scene text only: no file is opened, meshes stay [`MeshSlot::Unresolved`].
+pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) if !t.contains('\0') => t,
+        other => {
+            let (valid_up_to, what) = match other {
+                Ok(t) => (t.find('\0').unwrap_or(0), "a NUL byte".to_string()),
+                Err(e) => {
+                    let b = bytes.get(e.valid_up_to()).copied().unwrap_or(0);
+                    (
+                        e.valid_up_to(),
+                        format!("byte 0x{b:02x}, which is not UTF-8 text"),
+                    )
+                }
+            };
+            let prefix = std::str::from_utf8(&bytes[..valid_up_to]).unwrap_or("");
+            let src = SourceFile::new(name, prefix);
+            let d = src.diagnostic(
+                Severity::Error,
+                valid_up_to,
+                format!("this is not a text scene file: found {what}"),
+            );
+            return ParseOutcome {
+                scene: None,
+                diagnostics: Diagnostics(vec![d]),
+                lost_comments: Vec::new(),
+                meshes: Vec::new(),
+                unshown: UnshownSummary::default(),
+            };
+        }
+    };
+    let mut p = Parser {
+        src: SourceFile::new(name, text),
+        toks: TokenStream::new(text),
+        next_comment: 0,
+        pending_comments: Vec::new(),
+        lost_comments: Vec::new(),
+        scene_comments: SceneComments::default(),
+        pos: 0,
+        diags: Vec::new(),
+        unshown: Unshown::default(),
+        fatal: false,
+        out_of_memory: false,
+        camera: None,
+        camera_seen: false,
+        group_seen: false,
+        lights: None,
+        background: None,
+        materials: Vec::new(),
+        graph: None,
+        material_refs: Vec::new(),
+        leaf_offsets: Vec::new(),
+        node_offsets: Vec::new(),
+        mesh_name_offsets: Vec::new(),
+        mesh_operands: Vec::new(),
+        last_obj_name: 0,
+    };
+    p.parse_file();
+    p.finish()
+}
+
+struct Parser<'a> {
+    src: SourceFile<'a>,
+    /// Tokens and comments, lexed as the parser reaches them; comments before
+    /// `next_comment` have been attached or lost.
+    toks: TokenStream<'a>,
+    next_comment: usize,
+    /// Comments before a MaterialIndex, waiting for the object it applies to.
+    pending_comments: Vec<String>,
+    lost_comments: Vec<Diagnostic>,
+    scene_comments: SceneComments,
+    pos: usize,
+    diags: Vec<Diagnostic>,
+    unshown: Unshown,
+    /// Set by any error that leaves the scene incomplete.
+    fatal: bool,
+    /// The scene's objects outgrew the memory there is: the parse stops there.
+    out_of_memory: bool,
+    camera: Option<Camera>,
+    /// A camera or object Group block was present (even if broken): do not also report it missing.
+    camera_seen: bool,
+    group_seen: bool,
+    lights: Option<Vec<Light>>,
+    background: Option<Background>,
+    materials: Vec<Material>,
+    graph: Option<Graph>,
+    /// (index, offset) of each MaterialIndex, checked once all materials are known.
+    material_refs: Vec<(u32, usize)>,
+    /// (node, offset) of each primitive, for warnings that need the final tree.
+    leaf_offsets: Vec<(NodeId, usize)>,
+    /// Offset of each object's keyword, indexed by node id (for errors about operands).
+    node_offsets: Vec<usize>,
+    /// (node, offset of its file name) of each TriangleMesh, for the resolve step.
+    mesh_name_offsets: Vec<(NodeId, usize)>,
+    /// (mesh node, operation, offset) of each TriangleMesh that is a CSG operand: the
+    /// resolve step checks that it is closed.
+    mesh_operands: Vec<(NodeId, CsgOp, usize)>,
+    /// Offset of the last TriangleMesh's file name, read by `start_object`.
+    last_obj_name: usize,
+}
+
+/// Where something stands in a scene file (1-based line and column).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Located {
+    pub file: String,
+    pub line: u32,
+    pub col: u32,
+}
+
+/// A TriangleMesh node as the parser left it: the file to load, where its name stands, and
+/// the CSG operations it is an operand of (each with the operand's location).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshRef {
+    pub node: NodeId,
+    pub obj_file: String,
+    pub at: Located,
+    pub operand_of: Vec<(CsgOp, Located)>,
+}
+
+/// Errors (and, separately, warnings) past this many are counted, not shown: a file of a
+/// million stray braces must not print a million lines.
+pub(super) const MAX_SHOWN: usize = 20;
+
+/// Diagnostics beyond the first `MAX_SHOWN` of their severity: how many, and where the first
+/// of them is.
+#[derive(Default)]
+struct Unshown {
+    shown_errors: usize,
+    shown_warnings: usize,
+    errors: (usize, usize),
+    warnings: (usize, usize),
+}
+
+/// Whether the reader takes this word as a number (a bad one is an error, never a name).
+pub(crate) fn is_numberlike(s: &str) -> bool {
+    let first = s.as_bytes().first().copied().unwrap_or(b'a');
+    first.is_ascii_digit()
+        || matches!(first, b'-' | b'+' | b'.')
+        || ["nan", "inf", "infinity"]
+            .iter()
+            .any(|k| s.eq_ignore_ascii_case(k))
+}
+
+impl Parser<'_> {
+    // ---------------------------------------------------------------- completion
+
+    fn finish(mut self) -> ParseOutcome {
+        let end = self.src.text.len();
+        self.scene_comments.end = self.comments_before(self.toks.len());
+        let n = self.materials.len();
+        for (i, at) in std::mem::take(&mut self.material_refs) {
+            if i as usize >= n {
+                let range = if n == 0 {
+                    "the scene has no materials".to_string()
+                } else {
+                    format!("valid indices are 0 to {}", n - 1)
+                };
+                let written = self.word_at(at);
+                self.error(
+                    at,
+                    format!("MaterialIndex {written} is out of range: {range}"),
+                );
+            }
+        }
+        if self.camera.is_none() && !self.camera_seen {
+            self.error(
+                end,
+                "the scene has no camera (OrthographicCamera or PerspectiveCamera)",
+            );
+        }
+        if self.graph.is_none() && !self.group_seen {
+            self.error(end, "the scene has no Group of objects");
+        }
+        if let Some(graph) = &self.graph {
+            // Composed through each chain, so nested scales are judged together.
+            for p in validate::check_world_chain(graph) {
+                let at = p
+                    .node()
+                    .and_then(|id| self.node_offsets.get(id.index()).copied())
+                    .unwrap_or(0);
+                self.error(at, p.message);
+            }
+        }
+        if let Some(graph) = &self.graph {
+            let eff = graph.effective_materials();
+            let missing: Vec<usize> = self
+                .leaf_offsets
+                .iter()
+                .filter(|(id, _)| eff.get(id.index()).copied().flatten().is_none())
+                .map(|(_, at)| *at)
+                .collect();
+            for (k, at) in missing.iter().enumerate() {
+                if k == 5 {
+                    self.warn(
+                        *at,
+                        format!("{} more objects have no material", missing.len() - 5),
+                    );
+                    break;
+                }
+                self.warn(
+                    *at,
+                    "no MaterialIndex applies to this object; it uses the default grey material",
+                );
+            }
+        }
+        let unshown = self.summarise_unshown();
+        let scene = if self.fatal {
+            None
+        } else {
+            Some(Scene {
+                camera: self.camera.take().unwrap_or_default(),
+                lights: self.lights.take(),
+                background: self.background.take().unwrap_or_default(),
+                materials: std::mem::take(&mut self.materials),
+                graph: self.graph.take().unwrap_or_default(),
+                comments: std::mem::take(&mut self.scene_comments),
+            })
+        };
+        let meshes = self.mesh_refs(scene.as_ref());
+        ParseOutcome {
+            scene,
+            diagnostics: Diagnostics(self.diags),
+            lost_comments: self.lost_comments,
+            meshes,
+            unshown,
+        }
+    }
+
+    /// The TriangleMesh nodes with their file names and locations (also for a scene too
+    /// broken to keep, so that a missing OBJ file is reported with the other errors).
+    fn mesh_refs(&self, scene: Option<&Scene>) -> Vec<MeshRef> {
+        let graph = scene.map(|s| &s.graph).or(self.graph.as_ref());
+        let place = |off: usize| {
+            let d = self.src.diagnostic(Severity::Error, off, "");
+            Located {
+                file: d.file,
+                line: d.line,
+                col: d.col,
+            }
+        };
+        let mut refs: Vec<MeshRef> = self
+            .mesh_name_offsets
+            .iter()
+            .filter_map(|&(node, off)| {
+                let obj_file = match graph.and_then(|g| g.get(node)).map(|n| &n.kind) {
+                    Some(NodeKind::TriangleMesh { obj_file, .. }) => obj_file.clone(),
+                    _ => return None,
+                };
+                Some(MeshRef {
+                    node,
+                    obj_file,
+                    at: place(off),
+                    operand_of: Vec::new(),
+                })
+            })
+            .collect();
+        let index: HashMap<NodeId, usize> =
+            refs.iter().enumerate().map(|(i, r)| (r.node, i)).collect();
+        for &(node, op, off) in &self.mesh_operands {
+            if let Some(&i) = index.get(&node) {
+                refs[i].operand_of.push((op, place(off)));
+            }
+        }
+        refs
+    }
+}
