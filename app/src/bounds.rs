@@ -1,80 +1,20 @@
 //! Where things are in the world, from the document's scene (not a render): the matrix
 //! above a node and the world box of a node's objects, for framing and for the gizmo.
 
-use glam::{DMat4, Mat4, Vec3};
-use tracelab_core::scene::compose_f64;
-use tracelab_core::{NodeId, NodeKind, Scene};
+use glam::{Mat4, Vec3};
+use tracelab_core::scene::walk;
+use tracelab_core::{NodeId, Scene};
 
 /// World from the space `node` itself sits in: the product of every Transform above it
 /// (not its own ops). `None` when the node is not in the scene.
 pub fn world_from_parent(scene: &Scene, node: NodeId) -> Option<Mat4> {
-    let path = scene.graph.path_to(node)?;
-    let mut m = DMat4::IDENTITY;
-    for id in &path[..path.len().saturating_sub(1)] {
-        if let Some(NodeKind::Transform(ops)) = scene.graph.get(*id).map(|n| &n.kind) {
-            m *= compose_f64(ops);
-        }
-    }
-    Some(m.as_mat4())
+    walk::visit(&scene.graph, node).map(|v| v.world_from_parent.as_mat4())
 }
 
 /// The world box (min, max) of everything with finite bounds under `node` (planes have
-/// none). `None` when there is nothing to bound.
+/// none): core's [`walk::world_bounds`]. `None` when there is nothing to bound.
 pub fn world_bounds(scene: &Scene, node: NodeId) -> Option<(Vec3, Vec3)> {
-    let start = world_from_parent(scene, node)?;
-    let mut acc: Option<(Vec3, Vec3)> = None;
-    let mut stack = vec![(node, start.as_dmat4())];
-    while let Some((id, m)) = stack.pop() {
-        let Some(n) = scene.graph.get(id) else {
-            continue;
-        };
-        let local = match &n.kind {
-            NodeKind::Transform(ops) => {
-                let m = m * compose_f64(ops);
-                stack.extend(n.children.iter().map(|&c| (c, m)));
-                continue;
-            }
-            NodeKind::Group | NodeKind::Csg(_) => {
-                stack.extend(n.children.iter().map(|&c| (c, m)));
-                continue;
-            }
-            NodeKind::Sphere { center, radius } => Some((
-                *center - Vec3::splat(*radius),
-                *center + Vec3::splat(*radius),
-            )),
-            NodeKind::Box { min, max } => Some((*min, *max)),
-            NodeKind::Triangle {
-                vertices: [a, b, c],
-            } => Some((a.min(*b).min(*c), a.max(*b).max(*c))),
-            NodeKind::TriangleMesh { mesh, .. } => mesh.mesh().map(|m| {
-                let b = m.bounds();
-                (b.min, b.max)
-            }),
-            NodeKind::Plane { .. } => None,
-        };
-        let Some((lo, hi)) =
-            local.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo.cmple(*hi).all())
-        else {
-            continue;
-        };
-        let m = m.as_mat4();
-        for i in 0..8 {
-            let corner = Vec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            );
-            let p = m.transform_point3(corner);
-            if !p.is_finite() {
-                continue;
-            }
-            acc = Some(match acc {
-                None => (p, p),
-                Some((a, b)) => (a.min(p), b.max(p)),
-            });
-        }
-    }
-    acc
+    walk::world_bounds(&scene.graph, node).map(|b| (b.min, b.max))
 }
 
 /// The centre of `node`'s world box: where the gizmo stands. Under any affine transform the
@@ -87,7 +27,7 @@ pub fn world_centre(scene: &Scene, node: NodeId) -> Option<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tracelab_core::{MeshCache, parse_scene};
+    use tracelab_core::{MeshCache, NodeKind, parse_scene};
 
     #[test]
     fn a_sphere_under_scale_and_translate_has_the_transformed_box() {

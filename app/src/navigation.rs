@@ -6,6 +6,7 @@
 
 use glam::{Quat, Vec2, Vec3};
 use tracelab_core::Camera;
+use tracelab_core::render::CameraRays;
 use tracelab_core::scene::unit;
 
 /// Blender's turntable sensitivity: 0.4° of orbit per point of drag.
@@ -16,19 +17,12 @@ pub const ZOOM_PER_NOTCH: f32 = 1.2;
 /// spin about itself and flip.
 const MAX_ELEVATION_DEGREES: f32 = 89.0;
 
-/// The camera's frame as the renderer builds it, with the image it renders into: maps
-/// between world points, image pixels (continuous, (0, 0) the top-left corner) and rays.
+/// The camera's frame as the renderer builds it (core's `CameraRays`, so what is drawn
+/// over the image lines up with its rays), with the image it renders into: maps between
+/// world points, image pixels (continuous, (0, 0) the top-left corner) and rays.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewBasis {
-    pub center: Vec3,
-    /// Unit view direction.
-    pub direction: Vec3,
-    /// Unit screen right and up (up made perpendicular to the direction).
-    pub horizontal: Vec3,
-    pub up: Vec3,
-    /// Orthographic: the size; perspective: 2·tan(angle/2).
-    pub extent: f32,
-    pub perspective: bool,
+    pub rays: CameraRays,
     /// Image size in pixels.
     pub width: f32,
     pub height: f32,
@@ -36,15 +30,8 @@ pub struct ViewBasis {
 
 impl ViewBasis {
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        // Core's own camera basis, so what is drawn over the image lines up with its rays.
-        let c = tracelab_core::render::CameraRays::new(camera);
         ViewBasis {
-            center: c.center,
-            direction: c.direction,
-            horizontal: c.horizontal,
-            up: c.up,
-            extent: c.extent,
-            perspective: c.perspective,
+            rays: CameraRays::new(camera),
             width: width.max(1) as f32,
             height: height.max(1) as f32,
         }
@@ -64,55 +51,47 @@ impl ViewBasis {
         )
     }
 
-    /// The ray (origin, unit direction) through an image position in pixels.
+    /// The ray (origin, unit direction) through an image position in pixels: core's
+    /// `CameraRays::ray_at` at its screen point.
     pub fn ray(&self, px: Vec2) -> (Vec3, Vec3) {
         let p = self.screen(px);
-        let (sx, sy) = ((p.x - 0.5) * self.extent, (p.y - 0.5) * self.extent);
-        if self.perspective {
-            (
-                self.center,
-                (self.direction + sx * self.horizontal + sy * self.up).normalize(),
-            )
-        } else {
-            (
-                self.center + sx * self.horizontal + sy * self.up,
-                self.direction,
-            )
-        }
+        let r = self.rays.ray_at(p.x, p.y);
+        (r.origin, r.direction)
     }
 
     /// Depth of a world point along the view direction.
     pub fn depth(&self, world: Vec3) -> f32 {
-        (world - self.center).dot(self.direction)
+        (world - self.rays.center).dot(self.rays.direction)
     }
 
     /// The image position (pixels) of a world point; `None` behind a perspective camera.
     pub fn project(&self, world: Vec3) -> Option<Vec2> {
-        let q = world - self.center;
-        let z = q.dot(self.direction);
-        let (sx, sy) = if self.perspective {
+        let c = &self.rays;
+        let q = world - c.center;
+        let z = q.dot(c.direction);
+        let (sx, sy) = if self.rays.perspective {
             if z <= 1e-6 {
                 return None;
             }
-            (q.dot(self.horizontal) / z, q.dot(self.up) / z)
+            (q.dot(c.horizontal) / z, q.dot(c.up) / z)
         } else {
-            (q.dot(self.horizontal), q.dot(self.up))
+            (q.dot(c.horizontal), q.dot(c.up))
         };
         let s = self.span();
-        let x = (sx / self.extent + 0.5) * s - (s - self.width) * 0.5;
-        let y = (sy / self.extent + 0.5) * s - (s - self.height) * 0.5;
+        let x = (sx / self.rays.extent + 0.5) * s - (s - self.width) * 0.5;
+        let y = (sy / self.rays.extent + 0.5) * s - (s - self.height) * 0.5;
         let p = Vec2::new(x, self.height - y);
         p.is_finite().then_some(p)
     }
 
     /// World units per image pixel at depth `depth` (in the image plane).
     pub fn world_per_pixel(&self, depth: f32) -> f32 {
-        let at = if self.perspective {
+        let at = if self.rays.perspective {
             depth.max(1e-4)
         } else {
             1.0
         };
-        at * self.extent / self.span()
+        at * self.rays.extent / self.span()
     }
 }
 
@@ -163,7 +142,7 @@ pub fn orbit(start: &Camera, pivot: Vec3, yaw: f32, pitch: f32) -> Camera {
 /// `depth`: the point at that depth under the cursor stays under it (the scene is grabbed).
 pub fn pan(start: &Camera, basis: &ViewBasis, depth: f32, dx: f32, dy: f32) -> Camera {
     let k = basis.world_per_pixel(depth);
-    let shift = -(dx * k) * basis.horizontal + (dy * k) * basis.up;
+    let shift = -(dx * k) * basis.rays.horizontal + (dy * k) * basis.rays.up;
     with_pose(start, start.center() + shift, start.direction(), start.up())
 }
 

@@ -522,12 +522,8 @@ pub fn node_similitudes(
     use tracelab_core::NodeKind;
     use tracelab_core::scene::compose_f64;
     let g = &scene.graph;
-    let mut chain = DMat4::IDENTITY;
-    for p in g.path_to(id).unwrap_or_default() {
-        if let Some(NodeKind::Transform(ops)) = g.get(p).map(|n| &n.kind) {
-            chain *= compose_f64(ops);
-        }
-    }
+    let chain =
+        tracelab_core::scene::walk::visit(g, id).map_or(DMat4::IDENTITY, |v| v.world_from_object);
     let own = match g.get(id).map(|n| &n.kind) {
         Some(NodeKind::Transform(ops)) => Some(similitude(DMat3::from_mat4(compose_f64(ops)))),
         _ => None,

@@ -4,7 +4,7 @@
 //! lives in; factors move by a share of their own size.
 
 use glam::Mat4;
-use tracelab_core::scene::compose;
+use tracelab_core::scene::{compose, walk};
 use tracelab_core::{Camera, NodeId, NodeKind, Scene};
 
 /// Points of drag that move a length across the whole view: about the width of the view
@@ -78,14 +78,11 @@ fn view_extent(camera: &Camera) -> f32 {
 /// one number for a possibly non-uniform scale.
 pub fn world_per_unit(scene: &Scene, node: NodeId, op_index: Option<usize>) -> f32 {
     let g = &scene.graph;
-    let path = g.path_to(node).unwrap_or_default();
-    let mut m = Mat4::IDENTITY;
-    for &id in path.iter().filter(|&&id| id != node) {
-        if let Some(NodeKind::Transform(ops)) = g.get(id).map(|n| &n.kind) {
-            m *= compose(ops);
-        }
-    }
-    if let (Some(i), Some(NodeKind::Transform(ops))) = (op_index, g.get(node).map(|n| &n.kind)) {
+    let Some(v) = walk::visit(g, node) else {
+        return 1.0;
+    };
+    let mut m = v.world_from_parent.as_mat4();
+    if let (Some(i), NodeKind::Transform(ops)) = (op_index, &v.node.kind) {
         m *= compose(ops.get(..i).unwrap_or(ops));
     }
     let s = m.determinant().abs().cbrt();

@@ -61,7 +61,7 @@ pub fn subtree_ids(scene: &Scene, node: NodeId) -> Vec<bool> {
 
 /// A world direction as a screen vector (points, y down), as seen by the camera.
 fn on_screen(basis: &ViewBasis, d: Vec3) -> egui::Vec2 {
-    egui::vec2(d.dot(basis.horizontal), -d.dot(basis.up))
+    egui::vec2(d.dot(basis.rays.horizontal), -d.dot(basis.rays.up))
 }
 
 /// The world axes in the image's lower-left corner.
@@ -76,8 +76,8 @@ pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
     // Farthest first, so the nearer axes draw over it.
     let mut order: Vec<_> = axes.iter().collect();
     order.sort_by(|a, b| {
-        b.0.dot(basis.direction)
-            .total_cmp(&a.0.dot(basis.direction))
+        b.0.dot(basis.rays.direction)
+            .total_cmp(&a.0.dot(basis.rays.direction))
     });
     for (d, name, c) in order {
         let v = on_screen(basis, *d) * 20.0;
@@ -116,7 +116,7 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
             // Drawn, not typed: the UI's fonts have no ⊗ or ⊙.
             let stroke = egui::Stroke::new(2.0, colour);
             painter.circle_stroke(o, 7.0, stroke);
-            if d.dot(basis.direction) > 0.0 {
+            if d.dot(basis.rays.direction) > 0.0 {
                 painter.line_segment(
                     [o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)],
                     stroke,

@@ -344,20 +344,13 @@ impl Orbit {
 mod tests {
     use super::*;
     use tracelab_core::render::inspect_pixel;
-    use tracelab_core::scene::compose_f64;
+    use tracelab_core::scene::walk;
     use tracelab_core::{CompiledScene, MeshCache, RenderSettings, parse_scene};
 
     /// The composed world-from-object matrix of the node a story hit, from its path (f64).
     fn world_from_object(scene: &Scene, story: &RayStory) -> Option<DMat4> {
         let h = story.hit.as_ref()?;
-        let g = &scene.graph;
-        let mut m = DMat4::IDENTITY;
-        for id in g.path_to(h.node)? {
-            if let Some(NodeKind::Transform(ops)) = g.get(id).map(|n| &n.kind) {
-                m *= compose_f64(ops);
-            }
-        }
-        Some(m)
+        walk::visit(&scene.graph, h.node).map(|v| v.world_from_object)
     }
 
     fn sheared() -> Scene {

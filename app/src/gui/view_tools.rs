@@ -269,7 +269,7 @@ impl ViewTools {
                 // Over the background: the point on the pointer's ray at the pivot's depth.
                 let (o, d) = view.ray(at);
                 let depth = view.basis.depth(fallback_pivot(doc)).max(1e-3);
-                o + d * (depth / d.dot(view.basis.direction).max(1e-3))
+                o + d * (depth / d.dot(view.basis.rays.direction).max(1e-3))
             });
             self.wheel_toward = Some(toward);
             self.last_wheel = Some(Instant::now());

@@ -16,8 +16,7 @@ use crate::geometry::{
     intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
 };
 use crate::memory::{OutOfMemory, try_with_capacity};
-use crate::scene::compose_f64;
-use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, unit};
+use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, Walk, unit};
 
 #[derive(Clone, Debug)]
 pub enum Shape {
@@ -82,15 +81,6 @@ pub struct CompiledScene {
     single_mesh: Option<u32>,
 }
 
-/// Room on the compile walk's stack for `more` children (a Group of a million spheres puts
-/// a million matrices there), fallibly.
-fn reserve_walk<T>(stack: &mut Vec<T>, more: usize) -> Result<(), OutOfMemory> {
-    crate::memory::fallibly(|| stack.try_reserve(more)).map_err(|_| OutOfMemory {
-        what: "the scene's objects",
-        bytes: ((stack.len() + more) * std::mem::size_of::<T>()) as u64,
-    })
-}
-
 impl CompiledScene {
     /// The scene compiled for rendering; where it does not fit in memory, ends the process as
     /// a failed allocation does (see [`CompiledScene::try_new`] for an error instead).
@@ -117,28 +107,11 @@ impl CompiledScene {
             .filter(|(_, n)| !matches!(n.kind, NodeKind::Group | NodeKind::Transform(_)))
             .count();
         let mut objects: Vec<Object> = try_with_capacity(most, "the scene's objects")?;
-        // (node, world_from_object, material in effect)
-        let mut stack = vec![(g.root(), DMat4::IDENTITY, None::<u32>)];
-        while let Some((id, m, inherited)) = stack.pop() {
-            let Some(node) = g.get(id) else { continue };
-            let material = node.material.or(inherited);
-            let shape = match &node.kind {
-                NodeKind::Group => {
-                    let children = g.list_materials(node, material);
-                    reserve_walk(&mut stack, children.len())?;
-                    for (c, inherited) in children.into_iter().rev() {
-                        stack.push((c, m, inherited));
-                    }
-                    continue;
-                }
-                NodeKind::Transform(ops) => {
-                    let m = m * compose_f64(ops);
-                    reserve_walk(&mut stack, node.children.len())?;
-                    for &c in node.children.iter().rev() {
-                        stack.push((c, m, material));
-                    }
-                    continue;
-                }
+        let mut walk = Walk::new(g);
+        while let Some(v) = walk.next() {
+            let (id, m, material) = (v.id, v.world_from_object, v.material);
+            let shape = match &v.node.kind {
+                NodeKind::Group | NodeKind::Transform(_) => continue,
                 NodeKind::Sphere { center, radius } => Shape::Sphere {
                     center: *center,
                     radius: *radius,
@@ -172,6 +145,7 @@ impl CompiledScene {
                 NodeKind::Csg(_) => {
                     // One object for the whole subtree: its leaves keep their own transforms
                     // and materials, and its bounds go into the top-level BVH.
+                    walk.skip_children();
                     let resolve =
                         |m: Option<u32>| m.filter(|&i| i < n_mat).unwrap_or(default_material);
                     let tree = CsgTree::build(g, id, m, material, &resolve);

@@ -16,8 +16,7 @@ use crate::accel::TriangleHit;
 use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots,
 };
-use crate::scene::compose_f64;
-use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, unit};
+use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, Walk, unit};
 
 /// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low
 /// bits, whether the ray leaves that leaf there, and whether the normal is flipped (a
@@ -121,68 +120,100 @@ impl CsgTree {
         material: Option<u32>,
         resolve: &dyn Fn(Option<u32>) -> u32,
     ) -> CsgTree {
-        enum Work {
-            Visit(Option<NodeId>, DMat4, Option<u32>),
-            Emit(CsgOp),
+        /// A container whose operand slots are being filled: a CSG node has two, a
+        /// Transform one; extra children are not read, missing ones are empty.
+        struct Open {
+            depth: usize,
+            op: Option<CsgOp>,
+            slots: usize,
+            filled: usize,
         }
         let mut leaves = Vec::new();
         let mut program = Vec::new();
-        let mut stack = vec![Work::Visit(Some(root), world_from_root, material)];
-        while let Some(w) = stack.pop() {
-            let (id, m, inherited) = match w {
-                Work::Emit(op) => {
-                    program.push(Step::Op(op));
+        let mut open: Vec<Open> = Vec::new();
+        let empty = |leaves: &mut Vec<CsgLeaf>, program: &mut Vec<Step>, node: NodeId| {
+            program.push(Step::Leaf(leaves.len() as u32));
+            leaves.push(CsgLeaf {
+                solid: Solid::Empty,
+                xf: None,
+                material: resolve(material),
+                node,
+            });
+        };
+        let close = |o: Open, leaves: &mut Vec<CsgLeaf>, program: &mut Vec<Step>| {
+            // An edited scene may hold fewer operands: read as empty.
+            for _ in o.filled..o.slots {
+                empty(leaves, program, root);
+            }
+            if let Some(op) = o.op {
+                program.push(Step::Op(op));
+            }
+        };
+        let mut walk = Walk::from_node(graph, root, world_from_root, material);
+        while let Some(v) = walk.next() {
+            while open.last().is_some_and(|o| o.depth >= v.depth) {
+                let o = open.pop().expect("checked");
+                close(o, &mut leaves, &mut program);
+            }
+            if let Some(parent) = open.last_mut() {
+                if parent.filled == parent.slots {
+                    walk.skip_children();
                     continue;
                 }
-                Work::Visit(id, m, inherited) => (id, m, inherited),
-            };
-            let node = id.and_then(|id| graph.get(id));
-            let material = node.and_then(|n| n.material).or(inherited);
-            let solid = match node.map(|n| &n.kind) {
-                Some(NodeKind::Csg(op)) => {
-                    let children = node.map_or(&[][..], |n| n.children.as_slice());
-                    // Exactly two operands; an edited scene may hold fewer, read as empty.
-                    stack.push(Work::Emit(*op));
-                    // Operands are a list: a MaterialIndex before A holds for B too.
-                    let listed = node
-                        .map(|n| graph.list_materials(n, material))
-                        .unwrap_or_default();
-                    let inherited = |i: usize| listed.get(i).map_or(material, |l| l.1);
-                    stack.push(Work::Visit(children.get(1).copied(), m, inherited(1)));
-                    stack.push(Work::Visit(children.first().copied(), m, inherited(0)));
+                parent.filled += 1;
+            }
+            let m = v.world_from_object;
+            let solid = match &v.node.kind {
+                NodeKind::Csg(op) => {
+                    open.push(Open {
+                        depth: v.depth,
+                        op: Some(*op),
+                        slots: 2,
+                        filled: 0,
+                    });
                     continue;
                 }
-                Some(NodeKind::Transform(ops)) => {
-                    let child = node.and_then(|n| n.children.first().copied());
-                    stack.push(Work::Visit(child, m * compose_f64(ops), material));
+                NodeKind::Transform(_) => {
+                    open.push(Open {
+                        depth: v.depth,
+                        op: None,
+                        slots: 1,
+                        filled: 0,
+                    });
                     continue;
                 }
-                Some(NodeKind::Sphere { center, radius }) => Solid::Sphere {
+                NodeKind::Sphere { center, radius } => Solid::Sphere {
                     center: *center,
                     radius: *radius,
                 },
-                Some(NodeKind::Box { min, max }) => Solid::Box {
+                NodeKind::Box { min, max } => Solid::Box {
                     min: *min,
                     max: *max,
                 },
-                Some(NodeKind::Plane { normal, offset }) => Solid::HalfSpace {
+                NodeKind::Plane { normal, offset } => Solid::HalfSpace {
                     normal: unit(*normal).unwrap_or(Vec3::Y),
                     offset: *offset,
                 },
-                Some(NodeKind::TriangleMesh {
+                NodeKind::TriangleMesh {
                     mesh: MeshSlot::Loaded(mesh),
                     ..
-                }) => Solid::Mesh(mesh.clone()),
+                } => Solid::Mesh(mesh.clone()),
                 // Groups, lone triangles and unloaded meshes bound no solid.
-                _ => Solid::Empty,
+                _ => {
+                    walk.skip_children();
+                    Solid::Empty
+                }
             };
             program.push(Step::Leaf(leaves.len() as u32));
             leaves.push(CsgLeaf {
                 solid,
                 xf: (m != DMat4::IDENTITY).then(|| Transform::from_f64(m)),
-                material: resolve(material),
-                node: id.unwrap_or(root),
+                material: resolve(v.material),
+                node: v.id,
             });
+        }
+        while let Some(o) = open.pop() {
+            close(o, &mut leaves, &mut program);
         }
         let bounds = program_bounds(&program, &leaves);
         CsgTree {

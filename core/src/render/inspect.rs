@@ -8,8 +8,7 @@ use super::compile::CompiledScene;
 use super::shade::{ShadeInfo, shade_hit};
 use super::{NormalTransform, ObjectRays, RenderSettings};
 use crate::geometry::Ray;
-use crate::scene::compose_f64;
-use crate::scene::{NodeId, NodeKind, Scene};
+use crate::scene::{NodeId, NodeKind, Scene, compose_f64, walk};
 
 /// One node on the way from the root to the object hit.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,27 +92,20 @@ pub fn inspect_pixel(
         .and_then(|hit| {
             // For a CSG hit, the operand whose surface it is (its path holds the CSG node).
             let node = compiled.hit_node(&hit)?;
-            let ids = scene.graph.path_to(node)?;
             // Composed and inverted in f64, as the renderer does, so the story matches it.
-            let mut m = DMat4::IDENTITY;
-            let mut path = Vec::with_capacity(ids.len());
-            for id in ids {
-                let n = scene.graph.get(id)?;
-                let transform = match &n.kind {
-                    NodeKind::Transform(ops) => Some(compose_f64(ops)),
-                    _ => None,
-                };
-                if let Some(t) = transform {
-                    m *= t;
-                }
-                path.push(PathStep {
-                    node: id,
-                    kind: n.kind.name(),
-                    world_from_local: m.as_mat4(),
-                    transform,
-                    ray: world_ray.transformed(&m.inverse().as_mat4()),
-                });
-            }
+            let path: Vec<PathStep> = walk::path(&scene.graph, node)?
+                .into_iter()
+                .map(|v| PathStep {
+                    node: v.id,
+                    kind: v.node.kind.name(),
+                    world_from_local: v.world_from_object.as_mat4(),
+                    transform: match &v.node.kind {
+                        NodeKind::Transform(ops) => Some(compose_f64(ops)),
+                        _ => None,
+                    },
+                    ray: world_ray.transformed(&v.world_from_object.inverse().as_mat4()),
+                })
+                .collect();
             let object_ray = path.last().map_or(world_ray, |s| s.ray);
             let ot = compiled.object_t(&world_ray, &hit, rule);
             // CSG operands carry their transforms inside the solid: they keep the plain rule.

@@ -253,21 +253,6 @@ impl Graph {
         Some(path)
     }
 
-    /// The material each reachable node renders with (`None`: the default material).
-    pub fn effective_materials(&self) -> Vec<Option<u32>> {
-        let mut out = vec![None; self.nodes.len()];
-        let mut stack = vec![(self.root, None::<u32>)];
-        while let Some((id, inherited)) = stack.pop() {
-            let node = self.node(id);
-            let m = node.material.or(inherited);
-            out[id.index()] = m;
-            for (c, inherited) in self.list_materials(node, m).into_iter().rev() {
-                stack.push((c, inherited));
-            }
-        }
-        out
-    }
-
     /// What each child of `node` inherits when it sets no material, given the material `m`
     /// in effect at `node`. In the file (and in the course's parser) a MaterialIndex holds
     /// for every later object of its list, so in a Group's or CSG node's list a child

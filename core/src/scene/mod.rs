@@ -7,12 +7,14 @@ mod graph;
 mod mesh;
 mod transform;
 pub mod validate;
+pub mod walk;
 
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
 pub use transform::{TransformOp, compose, compose_f64, op_matrix_f64, unit};
 pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene};
+pub use walk::{Visit, Walk};
 
 use glam::Vec3;
 

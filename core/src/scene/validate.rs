@@ -5,6 +5,7 @@
 use glam::{DMat3, DMat4, Vec3};
 
 use super::transform::{compose_f64, op_matrix_f64, unit};
+use super::walk::Walk;
 use super::{Background, Camera, Graph, Light, Material, NodeId, NodeKind, Scene, TransformOp};
 
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
@@ -406,9 +407,8 @@ pub fn is_solid(graph: &Graph, id: NodeId) -> bool {
 /// them, and every Transform's world-from-object matrix composed through its whole chain.
 pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
     let mut out = Vec::new();
-    let mut stack = vec![(graph.root(), None::<NodeId>)];
-    while let Some((id, parent)) = stack.pop() {
-        let Some(node) = graph.get(id) else { continue };
+    for v in Walk::new(graph) {
+        let (id, node, parent) = (v.id, v.node, v.parent);
         let name = node.kind.name();
         let mut push = |field: &str, op: Option<usize>, reason: String, incomplete: bool| {
             // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
@@ -474,9 +474,6 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
             }
             _ => {}
         }
-        for &c in node.children.iter().rev() {
-            stack.push((c, Some(id)));
-        }
     }
     out.extend(check_world_chain(graph).into_iter().map(|p| Problem {
         message: format!(
@@ -494,33 +491,21 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
 /// name the node (the parser gives its location instead).
 pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
     let mut out = Vec::new();
-    let mut stack = vec![(graph.root(), DMat4::IDENTITY)];
-    while let Some((id, mut world)) = stack.pop() {
-        let Some(node) = graph.get(id) else { continue };
-        if let NodeKind::Transform(ops) = &node.kind {
-            world *= compose_f64(ops);
-            if let Err(e) = check_world_from_object(&world) {
-                let message = e.to_string();
-                out.push(Problem {
-                    place: Place::Node(id),
-                    field: "ops".into(),
-                    op: None,
-                    reason: message.clone(),
-                    message,
-                    incomplete: false,
-                });
-                continue;
-            }
-        }
-        // Only what can hold a Transform: a million spheres in a Group are not a million
-        // copies of its matrix on the stack.
-        for &c in node.children.iter().rev() {
-            if graph
-                .get(c)
-                .is_some_and(|n| matches!(n.kind, NodeKind::Transform(_)) || !n.children.is_empty())
-            {
-                stack.push((c, world));
-            }
+    let mut walk = Walk::new(graph);
+    while let Some(v) = walk.next() {
+        if let NodeKind::Transform(_) = &v.node.kind
+            && let Err(e) = check_world_from_object(&v.world_from_object)
+        {
+            let message = e.to_string();
+            out.push(Problem {
+                place: Place::Node(v.id),
+                field: "ops".into(),
+                op: None,
+                reason: message.clone(),
+                message,
+                incomplete: false,
+            });
+            walk.skip_children();
         }
     }
     out

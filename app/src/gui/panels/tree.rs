@@ -2,6 +2,7 @@
 //! a UI), then drawn; clicks and toolbar buttons become commands (selections and [`Edit`]s).
 
 use glam::Vec3;
+use tracelab_core::scene::Walk;
 use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 
 use crate::document::edit::Edit;
@@ -25,7 +26,6 @@ pub struct TreeRow {
 /// The object hierarchy as rows, parents first.
 pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
     let g = &scene.graph;
-    let mats = g.effective_materials();
     // The same rules the editor and Save apply; an edited document breaks none but
     // "incomplete" ones.
     let mut problems: std::collections::HashMap<NodeId, String> = std::collections::HashMap::new();
@@ -35,9 +35,8 @@ pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
         }
     }
     let mut rows = Vec::new();
-    let mut stack = vec![(g.root(), 0usize)];
-    while let Some((id, depth)) = stack.pop() {
-        let Some(n) = g.get(id) else { continue };
+    for v in Walk::new(g) {
+        let (id, n) = (v.id, v.node);
         let error = match &n.kind {
             NodeKind::TriangleMesh {
                 mesh: MeshSlot::Failed(e),
@@ -48,14 +47,11 @@ pub fn tree_rows(scene: &Scene) -> Vec<TreeRow> {
         let error = problems.remove(&id).or(error);
         rows.push(TreeRow {
             id,
-            depth,
+            depth: v.depth,
             label: node_label(&n.kind, n.children.len()),
-            material: mats.get(id.index()).copied().flatten(),
+            material: v.material,
             error,
         });
-        for &c in n.children.iter().rev() {
-            stack.push((c, depth + 1));
-        }
     }
     rows
 }
