@@ -329,6 +329,7 @@ mod tests {
         // No roll: the screen's right stays perpendicular to the up axis.
         assert!(
             ViewBasis::new(&after_cam, 400, 300)
+                .rays
                 .horizontal
                 .dot(cam.up().normalize())
                 .abs()

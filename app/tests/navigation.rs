@@ -175,7 +175,7 @@ fn a_middle_drag_orbits_by_04_degrees_per_point_about_the_point_under_the_pointe
     let tilted = camera(&h);
     assert!((angle_between(after.direction(), tilted.direction()) - 20.0).abs() < 0.05);
     assert!(
-        ViewBasis::new(&tilted, 10, 10).horizontal.y.abs() < 1e-5,
+        ViewBasis::new(&tilted, 10, 10).rays.horizontal.y.abs() < 1e-5,
         "no roll"
     );
 }

@@ -3,7 +3,6 @@
 //! across. Lengths move by a share of what the camera sees, measured in the space the value
 //! lives in; factors move by a share of their own size.
 
-use glam::Mat4;
 use tracelab_core::scene::{compose, walk};
 use tracelab_core::{Camera, NodeId, NodeKind, Scene};
 
