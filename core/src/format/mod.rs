@@ -13,7 +13,6 @@ mod writer;
 
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile, escape_controls};
 pub use load::{load_scene, parse_scene};
-pub(crate) use parser::is_numberlike;
 pub use parser::{
     Located, MAX_SCENE_BYTES, MeshRef, ParseOutcome, load_scene_unresolved, parse_scene_unresolved,
 };

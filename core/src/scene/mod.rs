@@ -8,6 +8,7 @@ mod mesh;
 mod transform;
 pub mod validate;
 pub mod walk;
+pub mod words;
 
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};

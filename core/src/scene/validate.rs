@@ -6,6 +6,7 @@ use glam::{DMat3, DMat4, Vec3};
 
 use super::transform::{compose_f64, op_matrix_f64, unit};
 use super::walk::Walk;
+use super::words::{is_numberlike, is_word};
 use super::{Background, Camera, Graph, Light, Material, NodeId, NodeKind, Scene, TransformOp};
 
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
@@ -182,18 +183,11 @@ pub fn check_background(b: &Background) -> Result<(), Invalid> {
 
 /// A word the lexer reads back as one token: not empty, no ASCII whitespace, braces, `#`
 /// or NUL (the reader refuses files holding one).
-fn is_word(s: &str) -> bool {
-    !s.is_empty()
-        && !s
-            .bytes()
-            .any(|c| c.is_ascii_whitespace() || matches!(c, b'{' | b'}' | b'#' | 0))
-}
-
 pub fn check_material(m: &Material) -> Result<(), Invalid> {
     finite3("diffuseColor", m.diffuse)?;
     for (i, (name, values)) in m.extra.iter().enumerate() {
         // The reader takes a number-like word as a value and `obj_file` as a mesh field.
-        if !is_word(name) || crate::format::is_numberlike(name) || name == "obj_file" {
+        if !is_word(name) || is_numberlike(name) || name == "obj_file" {
             let m = format!(
                 "material field name \"{}\" cannot be written",
                 name.escape_debug()

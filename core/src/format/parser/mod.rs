@@ -245,15 +245,8 @@ struct Unshown {
     warnings: (usize, usize),
 }
 
-/// Whether the reader takes this word as a number (a bad one is an error, never a name).
-pub(crate) fn is_numberlike(s: &str) -> bool {
-    let first = s.as_bytes().first().copied().unwrap_or(b'a');
-    first.is_ascii_digit()
-        || matches!(first, b'-' | b'+' | b'.')
-        || ["nan", "inf", "infinity"]
-            .iter()
-            .any(|k| s.eq_ignore_ascii_case(k))
-}
+/// (The rule is the scene's: a name must not read as a number; the reader follows it.)
+pub(crate) use crate::scene::words::is_numberlike;
 
 impl Parser<'_> {
     // ---------------------------------------------------------------- completion
