@@ -11,7 +11,11 @@ pub const FRAMES: &str = "tracelab::frames";
 
 /// Installs the logger once; later calls do nothing.
 pub fn init() {
-    let mut b = env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("off"));
+    let mut b = env_logger::Builder::new();
+    // Core's warnings (an unknown TRACELAB_SIMD, …) are shown unless RUST_LOG says otherwise:
+    // never silently ignored.
+    b.filter(Some("tracelab_core"), log::LevelFilter::Warn);
+    b.parse_env(env_logger::Env::default().default_filter_or("off"));
     let on = |var: &str| std::env::var_os(var).is_some_and(|v| !v.is_empty() && v != "0");
     if on("TRACELAB_LOG_TIMES") {
         b.filter(Some(TIMES), log::LevelFilter::Info);

@@ -31,7 +31,7 @@ pub fn detected() -> Level {
 }
 
 /// The level in use: `detected()`, lowered by `TRACELAB_SIMD` (read once; an unknown or
-/// wider value than the CPU has is ignored, with a warning on stderr).
+/// wider value than the CPU has is ignored, with a warning through `log`).
 #[inline]
 pub fn level() -> Level {
     static LEVEL: OnceLock<Level> = OnceLock::new();
@@ -44,16 +44,16 @@ fn choose(asked: Option<&str>, cpu: Level) -> Level {
         Some("sse") => Level::Sse,
         Some("avx") => Level::Avx,
         Some(other) => {
-            eprintln!(
-                "tracelab: TRACELAB_SIMD={other:?} is not one of sse, avx; using {}",
+            log::warn!(
+                "TRACELAB_SIMD={other:?} is not one of sse, avx; using {}",
                 cpu.name()
             );
             return cpu;
         }
     };
     if wanted > cpu {
-        eprintln!(
-            "tracelab: TRACELAB_SIMD={} but this CPU has only {}; using {}",
+        log::warn!(
+            "TRACELAB_SIMD={} but this CPU has only {}; using {}",
             wanted.name(),
             cpu.name(),
             cpu.name()

@@ -140,17 +140,6 @@ impl Frame {
         }
         out
     }
-
-    pub fn save(
-        &self,
-        view: View,
-        depth: (f32, f32),
-        path: &std::path::Path,
-    ) -> Result<(), image::ImageError> {
-        let img = image::RgbImage::from_raw(self.width, self.height, self.rgb8(view, depth))
-            .expect("buffer size matches the frame");
-        img.save(path)
-    }
 }
 
 /// Stores a pixel's results into `dst` field by field. Built whole and then copied, the
