@@ -100,7 +100,8 @@ def resolve(path, here, mods):
     return ()
 
 
-def cycles(src):
+def import_graph(src):
+    """(module -> file, module -> the modules it imports) for the crate under src."""
     mods = modules(src)
     graph = {m: set() for m in mods}
     for m, f in mods.items():
@@ -115,6 +116,11 @@ def cycles(src):
         for c in re.finditer(r"(?<![:\w])(\w+)::", own):
             if m + (c.group(1),) in mods:
                 graph[m].add(m + (c.group(1),))
+    return mods, graph
+
+
+def cycles(src):
+    mods, graph = import_graph(src)
     # Tarjan's strongly connected components.
     index, low, stack, on, sccs, counter = {}, {}, [], set(), [], [0]
 

@@ -637,7 +637,7 @@ fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
 /// "When does M·n happen to work?": the selected Transform's and the chain's similitude test.
 fn similitude_lines(ui: &mut egui::Ui, doc: &Document, id: NodeId) {
     let (own, chain) = crate::story::node_similitudes(&doc.scene, id);
-    let ascii = crate::gui::panels::pixel_inspector::ascii_math;
+    let ascii = crate::gui::widgets::ascii_math;
     if let Some(t) = own {
         ui.label(format!("This Transform: {}", ascii(&t.summary())));
     }

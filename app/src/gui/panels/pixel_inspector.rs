@@ -8,6 +8,7 @@ use glam::Vec3;
 use tracelab_core::render::{RayStory, inspect_pixel};
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
 
+use crate::gui::widgets::ascii_math;
 use crate::render_worker::Published;
 use crate::story::{HitReport, TransformReport, hit_report, transform_lines};
 
@@ -77,11 +78,6 @@ fn v(v: Vec3) -> String {
 
 fn a(xyz: [f32; 3]) -> String {
     v(Vec3::from_array(xyz))
-}
-
-/// egui's default fonts have no superscripts: M⁻¹ is drawn as M^-1, (M⁻¹)ᵀ as (M^-1)^T.
-pub fn ascii_math(s: &str) -> String {
-    s.replace("⁻¹", "^-1").replace('ᵀ', "^T")
 }
 
 /// M, M⁻¹, (M⁻¹)ᵀ and the similitude line of one Transform, in a monospace block.
