@@ -8,7 +8,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use tracelab_core::render::{NormalGap, normal_rule_gap, render_coarse, render_progressive};
+use tracelab_core::render::{NormalGap, RenderPlan, normal_rule_gap, render};
 use tracelab_core::{
     CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame,
 };
@@ -267,11 +267,12 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 ..job.settings
             };
             let pass = |info: tracelab_core::render::PassInfo| on_pass(i, info);
-            if job.coarse {
-                render_coarse(&compiled, &settings, &frames[i], &cancel, pass).is_ok()
+            let plan = if job.coarse {
+                RenderPlan::COARSE
             } else {
-                render_progressive(&compiled, &settings, &frames[i], &cancel, pass).is_ok()
-            }
+                RenderPlan::PROGRESSIVE
+            };
+            render(&compiled, &settings, plan, &frames[i], &*cancel, pass).is_ok()
         };
         let ok = if frames.len() == 2 {
             let (a, b) = rayon::join(|| render_one(0), || render_one(1));

@@ -25,7 +25,7 @@ pub use format::{
 pub use memory::OutOfMemory;
 pub use render::{
     CompiledScene, Frame, NormalTransform, ObjectRays, RenderSettings, Sample, SharedFrame, View,
-    compile, render_frame, render_progressive,
+    compile, render_frame,
 };
 pub use scene::{
     Anchor, Background, Camera, Comments, CsgOp, DEFAULT_MATERIAL_COLOR, Graph, Invalid, Light,

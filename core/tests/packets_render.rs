@@ -9,7 +9,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
+use tracelab_core::render::{RenderPlan, Tracing, Uncancellable, render};
 use tracelab_core::{
     CompiledScene, Frame, MeshCache, NormalTransform, RenderSettings, SharedFrame, load_scene,
 };
@@ -47,14 +47,25 @@ fn check(path: &Path, (w, h): (u32, u32)) {
                 normal_transform,
                 ..RenderSettings::new(w, h)
             };
-            let single = render_frame_traced(&c, &s, Tracing::SingleRays);
-            let packets = render_frame_traced(&c, &s, Tracing::Packets);
+            let full = |tracing| {
+                let target = SharedFrame::new();
+                let plan = RenderPlan::FULL.traced(tracing);
+                let Ok(()) = render(&c, &s, plan, &target, &Uncancellable, |_| {});
+                target.take()
+            };
+            let single = full(Tracing::SingleRays);
+            let packets = full(Tracing::Packets);
             same(&single, &packets)
                 .unwrap_or_else(|e| panic!("{} {s:?}: one pass: {e}", path.display()));
             let target = SharedFrame::new();
-            let never = std::sync::atomic::AtomicBool::new(false);
-            render_progressive_traced(&c, &s, &target, &never, Tracing::Packets, |_| {})
-                .expect("not cancelled");
+            let Ok(()) = render(
+                &c,
+                &s,
+                RenderPlan::PROGRESSIVE,
+                &target,
+                &Uncancellable,
+                |_| {},
+            );
             same(&single, &target.lock())
                 .unwrap_or_else(|e| panic!("{} {s:?}: progressive: {e}", path.display()));
         }

@@ -1,14 +1,12 @@
 //! `tracelab bench-progressive`: how long the GUI waits after a change for its first coarse
 //! image and for the full colour+normal+depth frame.
 
-use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use tracelab_core::render::SharedFrame;
-use tracelab_core::render::render_coarse;
-use tracelab_core::render::{Tracing, render_frame_traced, render_progressive_traced};
-use tracelab_core::{CompiledScene, RenderSettings, Scene, render_progressive};
+use tracelab_core::render::{RenderPlan, Tracing, Uncancellable, render};
+use tracelab_core::{CompiledScene, RenderSettings, Scene};
 
 use crate::bounds::world_bounds;
 use crate::navigation::orbit;
@@ -30,7 +28,6 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let scene = load_scene(Some(&b.scene))?;
     let settings = RenderSettings::new(w, h);
     let target = SharedFrame::try_sized(w, h)?;
-    let never = AtomicBool::new(false);
     let tracing = if b.single_rays {
         Tracing::SingleRays
     } else {
@@ -42,11 +39,14 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         let compiled = CompiledScene::new(&scene);
         let mut ends = Vec::new();
         if b.one_pass {
-            std::hint::black_box(render_frame_traced(&compiled, &settings, tracing));
+            let plan = RenderPlan::FULL.traced(tracing);
+            let Ok(()) = render(&compiled, &settings, plan, &target, &Uncancellable, |_| {});
+            std::hint::black_box(target.take());
             let t = start.elapsed().as_secs_f64() * 1e3;
             return (t, t, vec![(1, t)]);
         }
-        let _ = render_progressive_traced(&compiled, &settings, &target, &never, tracing, |p| {
+        let plan = RenderPlan::PROGRESSIVE.traced(tracing);
+        let Ok(()) = render(&compiled, &settings, plan, &target, &Uncancellable, |p| {
             ends.push((p.scale, start.elapsed().as_secs_f64() * 1e3));
         });
         let full = ends
@@ -120,7 +120,6 @@ fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::
     let root = scene.graph.root();
     let pivot = world_bounds(scene, root).map_or(Vec3::ZERO, |(a, b)| (a + b) * 0.5);
     let target = SharedFrame::try_sized(settings.width, settings.height)?;
-    let never = AtomicBool::new(false);
     let step_scene = |k: usize| {
         let mut s = scene.clone();
         s.camera = orbit(&scene.camera, pivot, 360.0 * k as f32 / steps as f32, 0.0);
@@ -134,16 +133,24 @@ fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::
         let compiled = CompiledScene::new(&step_scene(k));
         let mut t_first = None;
         let mut t_last = Duration::ZERO;
-        let _ = render_coarse(&compiled, settings, &target, &never, |_| {
-            t_first.get_or_insert(start.elapsed());
-            t_last = start.elapsed();
-        });
+        let Ok(()) = render(
+            &compiled,
+            settings,
+            RenderPlan::COARSE,
+            &target,
+            &Uncancellable,
+            |_| {
+                t_first.get_or_insert(start.elapsed());
+                t_last = start.elapsed();
+            },
+        );
         first.push(t_first.unwrap_or(t_last).as_secs_f64() * 1e3);
         coarse_done.push(t_last.as_secs_f64() * 1e3);
         let start = Instant::now();
         let compiled = CompiledScene::new(&step_scene(k));
         let mut t_full = Duration::ZERO;
-        let _ = render_progressive(&compiled, settings, &target, &never, |_| {
+        let plan = RenderPlan::PROGRESSIVE;
+        let Ok(()) = render(&compiled, settings, plan, &target, &Uncancellable, |_| {
             t_full = start.elapsed()
         });
         full.push(t_full.as_secs_f64() * 1e3);

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use clap::ValueEnum;
-use tracelab_core::render::{SharedFrame, render_full};
+use tracelab_core::render::{RenderPlan, SharedFrame, Uncancellable, render};
 use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
 use super::progress::Progress;
@@ -243,8 +243,14 @@ pub(super) fn render_with_progress(
             bar.finish();
         })
     });
-    let never = AtomicBool::new(false);
-    let _ = render_full(scene, settings, &target, &never);
+    let Ok(()) = render(
+        scene,
+        settings,
+        RenderPlan::FULL,
+        &target,
+        &Uncancellable,
+        |_| {},
+    );
     done.store(true, Ordering::Relaxed);
     if let Some(w) = watcher {
         let _ = w.join();

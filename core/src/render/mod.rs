@@ -24,8 +24,8 @@ pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_s
 pub use mistakes::{Mistake, Variant};
 pub use object_rays::{ObjectRays, ObjectT};
 pub use progressive::{
-    Cancelled, PassInfo, SharedFrame, Tracing, render_coarse, render_frame, render_frame_traced,
-    render_full, render_progressive, render_progressive_traced, try_render_frame,
+    Cancel, Cancelled, PassInfo, Passes, RenderPlan, SharedFrame, Tracing, Uncancellable, render,
+    render_frame, try_render_frame,
 };
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};

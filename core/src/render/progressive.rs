@@ -69,6 +69,10 @@ impl SharedFrame {
     pub fn lock(&self) -> MutexGuard<'_, Frame> {
         self.frame.lock().unwrap_or_else(PoisonError::into_inner)
     }
+    /// The frame, leaving an empty one: a finished render's image as a value.
+    pub fn take(&self) -> Frame {
+        std::mem::replace(&mut *self.lock(), Frame::new(0, 0))
+    }
     pub fn version(&self) -> u64 {
         self.version.load(Ordering::Acquire)
     }
@@ -247,51 +251,130 @@ fn store_sample(
     }
 }
 
-/// Renders progressively into `target`, calling `on_pass` after each pass. Returns
-/// `Err(Cancelled)` promptly once `cancel` is set.
-pub fn render_progressive(
+/// Which passes a render makes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Passes {
+    /// Coarse passes (one ray per 8×8 block, 4×4, 2×2) then every pixel; straight to the
+    /// full pass when the first is quick.
+    #[default]
+    Progressive,
+    /// Only the first two coarse passes: what the editor renders while the mouse drags the
+    /// view, refining once it stops.
+    Coarse,
+    /// One full-resolution pass.
+    Full,
+}
+
+/// What a render does: its passes and how its primary rays are traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderPlan {
+    pub passes: Passes,
+    pub tracing: Tracing,
+}
+
+impl RenderPlan {
+    pub const PROGRESSIVE: RenderPlan = RenderPlan {
+        passes: Passes::Progressive,
+        tracing: Tracing::Packets,
+    };
+    pub const COARSE: RenderPlan = RenderPlan {
+        passes: Passes::Coarse,
+        tracing: Tracing::Packets,
+    };
+    pub const FULL: RenderPlan = RenderPlan {
+        passes: Passes::Full,
+        tracing: Tracing::Packets,
+    };
+
+    /// The same plan with its primary rays traced as `tracing` says.
+    pub fn traced(self, tracing: Tracing) -> RenderPlan {
+        RenderPlan { tracing, ..self }
+    }
+
+    fn schedule(&self) -> Schedule<'static> {
+        let (scales, straight_to_full_below): (&[u32], _) = match self.passes {
+            Passes::Progressive => (&SCALES, Some(STRAIGHT_TO_FULL_BELOW)),
+            Passes::Coarse => (&SCALES[..2], None),
+            Passes::Full => (&[1], None),
+        };
+        Schedule {
+            scales,
+            straight_to_full_below,
+            tracing: self.tracing,
+        }
+    }
+}
+
+/// A plan's passes spelt out (tests give their own).
+#[derive(Clone, Copy, Debug)]
+struct Schedule<'a> {
+    scales: &'a [u32],
+    /// Skip to the full pass when a pass took less than this.
+    straight_to_full_below: Option<Duration>,
+    tracing: Tracing,
+}
+
+/// What may stop a render between tiles: a flag (`AtomicBool`: `Err(Cancelled)` promptly
+/// once it is set) or nothing ([`Uncancellable`]: its error type is empty, so a caller
+/// writes `let Ok(()) = render(…)` and discards nothing).
+pub trait Cancel: Sync {
+    type Stop: Send;
+    fn stop(&self) -> Option<Self::Stop>;
+}
+
+impl Cancel for AtomicBool {
+    type Stop = Cancelled;
+    #[inline]
+    fn stop(&self) -> Option<Cancelled> {
+        self.load(Ordering::Relaxed).then_some(Cancelled)
+    }
+}
+
+/// A render nothing stops.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Uncancellable;
+
+impl Cancel for Uncancellable {
+    type Stop = std::convert::Infallible;
+    #[inline]
+    fn stop(&self) -> Option<std::convert::Infallible> {
+        None
+    }
+}
+
+/// The renderer's one entry point: renders into `target` as `plan` says, calling `on_pass`
+/// after each pass, until done or `cancel` stops it.
+pub fn render<C: Cancel>(
     scene: &CompiledScene,
     settings: &RenderSettings,
+    plan: RenderPlan,
     target: &SharedFrame,
-    cancel: &AtomicBool,
+    cancel: &C,
     mut on_pass: impl FnMut(PassInfo),
-) -> Result<(), Cancelled> {
+) -> Result<(), C::Stop> {
     render_scales(
         scene,
         settings,
+        plan.schedule(),
         target,
         cancel,
-        &SCALES,
-        Some(STRAIGHT_TO_FULL_BELOW),
-        Tracing::default(),
         &mut on_pass,
     )
 }
 
-/// Only the coarse passes (one ray per 8×8 block, then per 4×4): what the editor renders
-/// while the mouse drags the view, refining once it stops.
-pub fn render_coarse(
-    scene: &CompiledScene,
-    settings: &RenderSettings,
-    target: &SharedFrame,
-    cancel: &AtomicBool,
-    mut on_pass: impl FnMut(PassInfo),
-) -> Result<(), Cancelled> {
-    render_scales(
-        scene,
-        settings,
-        target,
-        cancel,
-        &SCALES[..2],
-        None,
-        Tracing::default(),
-        &mut on_pass,
-    )
-}
-
-/// Renders the full-resolution image in one pass.
+/// The full-resolution image as a value: [`render`] with [`RenderPlan::FULL`] into a frame of
+/// its own.
 pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
-    render_frame_traced(scene, settings, Tracing::default())
+    let target = SharedFrame::new();
+    let Ok(()) = render(
+        scene,
+        settings,
+        RenderPlan::FULL,
+        &target,
+        &Uncancellable,
+        |_| {},
+    );
+    target.take()
 }
 
 /// [`render_frame`], with an error instead of an abort where the frame does not fit in
@@ -301,71 +384,15 @@ pub fn try_render_frame(
     settings: &RenderSettings,
 ) -> Result<Frame, crate::memory::OutOfMemory> {
     let target = SharedFrame::try_sized(settings.width, settings.height)?;
-    let never = AtomicBool::new(false);
-    let _ = render_full(scene, settings, &target, &never);
-    Ok(std::mem::replace(&mut *target.lock(), Frame::new(0, 0)))
-}
-
-/// [`render_frame`] with the primary rays traced as `tracing` says.
-pub fn render_frame_traced(
-    scene: &CompiledScene,
-    settings: &RenderSettings,
-    tracing: Tracing,
-) -> Frame {
-    let target = SharedFrame::new();
-    let never = AtomicBool::new(false);
-    let _ = render_scales(
+    let Ok(()) = render(
         scene,
         settings,
+        RenderPlan::FULL,
         &target,
-        &never,
-        &[1],
-        None,
-        tracing,
-        &mut |_| {},
+        &Uncancellable,
+        |_| {},
     );
-    std::mem::replace(&mut *target.lock(), Frame::new(0, 0))
-}
-
-/// [`render_progressive`] with the primary rays traced as `tracing` says (for comparing the
-/// two in `bench-progressive`).
-pub fn render_progressive_traced(
-    scene: &CompiledScene,
-    settings: &RenderSettings,
-    target: &SharedFrame,
-    cancel: &AtomicBool,
-    tracing: Tracing,
-    mut on_pass: impl FnMut(PassInfo),
-) -> Result<(), Cancelled> {
-    render_scales(
-        scene,
-        settings,
-        target,
-        cancel,
-        &SCALES,
-        Some(STRAIGHT_TO_FULL_BELOW),
-        tracing,
-        &mut on_pass,
-    )
-}
-
-/// One full-resolution pass into `target` (which others may watch for progress).
-pub fn render_full(
-    scene: &CompiledScene,
-    settings: &RenderSettings,
-    target: &SharedFrame,
-    cancel: &AtomicBool,
-) -> Result<(), Cancelled> {
-    render_scales(
-        scene,
-        settings,
-        target,
-        cancel,
-        &[1],
-        None,
-        Tracing::default(),
-        &mut |_| {},
-    )
+    Ok(target.take())
 }
 
 /// The grid points of a tile's pass not traced before, in 4×2 neighbourhoods (two rows, four
@@ -502,17 +529,19 @@ fn passes_to_skip(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn render_scales(
+fn render_scales<C: Cancel>(
     scene: &CompiledScene,
     settings: &RenderSettings,
+    schedule: Schedule<'_>,
     target: &SharedFrame,
-    cancel: &AtomicBool,
-    scales: &[u32],
-    straight_to_full_below: Option<Duration>,
-    tracing: Tracing,
+    cancel: &C,
     on_pass: &mut dyn FnMut(PassInfo),
-) -> Result<(), Cancelled> {
+) -> Result<(), C::Stop> {
+    let Schedule {
+        scales,
+        straight_to_full_below,
+        tracing,
+    } = schedule;
     let start = Instant::now();
     let (w, h) = (settings.width, settings.height);
     if settings.variant.is_some() {
@@ -567,8 +596,8 @@ fn render_scales(
             let traced: Vec<(TilePass, Vec<Sample>)> = tiles
                 .par_iter()
                 .map(|t| {
-                    if cancel.load(Ordering::Relaxed) {
-                        return Err(Cancelled);
+                    if let Some(stop) = cancel.stop() {
+                        return Err(stop);
                     }
                     let tp = tile_pass(t);
                     let grid = trace_tile(scene, settings, &rays, tracing, &cull, &tp);
@@ -601,8 +630,8 @@ fn render_scales(
             target.bump();
         } else {
             tiles.par_iter().try_for_each(|t| {
-                if cancel.load(Ordering::Relaxed) {
-                    return Err(Cancelled);
+                if let Some(stop) = cancel.stop() {
+                    return Err(stop);
                 }
                 let tp = tile_pass(t);
                 let mut grid = trace_tile(scene, settings, &rays, tracing, &cull, &tp);
@@ -680,12 +709,16 @@ mod tests {
                 ];
                 for (plan, skip, scales, passes) in plans {
                     let target = SharedFrame::new();
-                    let never = AtomicBool::new(false);
                     let mut shown = Vec::new();
-                    render_scales(&c, &s, &target, &never, plan, skip, tracing, &mut |p| {
-                        shown.push((p.scale, p.passes, target.lock().clone()));
-                    })
-                    .expect("not cancelled");
+                    let schedule = Schedule {
+                        scales: plan,
+                        straight_to_full_below: skip,
+                        tracing,
+                    };
+                    let Ok(()) =
+                        render_scales(&c, &s, schedule, &target, &Uncancellable, &mut |p| {
+                            shown.push((p.scale, p.passes, target.lock().clone()));
+                        });
                     assert_eq!(shown.iter().map(|(s, _, _)| *s).collect::<Vec<_>>(), scales);
                     assert_eq!(shown.iter().map(|(_, n, _)| *n).collect::<Vec<_>>(), passes);
                     for (scale, _, f) in &shown {
@@ -753,7 +786,7 @@ mod tests {
         let target = SharedFrame::new();
         let cancel = AtomicBool::new(false);
         let mut after_first = None;
-        let r = render_progressive(&c, &s, &target, &cancel, |_| {
+        let r = render(&c, &s, RenderPlan::PROGRESSIVE, &target, &cancel, |_| {
             after_first.get_or_insert_with(|| target.lock().clone());
             cancel.store(true, Ordering::Relaxed);
         });
