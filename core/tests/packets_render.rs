@@ -58,14 +58,8 @@ fn check(path: &Path, (w, h): (u32, u32)) {
             same(&single, &packets)
                 .unwrap_or_else(|e| panic!("{} {s:?}: one pass: {e}", path.display()));
             let target = SharedFrame::new();
-            let Ok(()) = render(
-                &c,
-                &s,
-                RenderPlan::PROGRESSIVE,
-                &target,
-                &Uncancellable,
-                |_| {},
-            );
+            let plan = RenderPlan::PROGRESSIVE;
+            let Ok(()) = render(&c, &s, plan, &target, &Uncancellable, |_| {});
             same(&single, &target.lock())
                 .unwrap_or_else(|e| panic!("{} {s:?}: progressive: {e}", path.display()));
         }

@@ -243,14 +243,8 @@ pub(super) fn render_with_progress(
             bar.finish();
         })
     });
-    let Ok(()) = render(
-        scene,
-        settings,
-        RenderPlan::FULL,
-        &target,
-        &Uncancellable,
-        |_| {},
-    );
+    let plan = RenderPlan::FULL;
+    let Ok(()) = render(scene, settings, plan, &target, &Uncancellable, |_| {});
     done.store(true, Ordering::Relaxed);
     if let Some(w) = watcher {
         let _ = w.join();

@@ -365,16 +365,7 @@ pub fn render<C: Cancel>(
 /// The full-resolution image as a value: [`render`] with [`RenderPlan::FULL`] into a frame of
 /// its own.
 pub fn render_frame(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
-    let target = SharedFrame::new();
-    let Ok(()) = render(
-        scene,
-        settings,
-        RenderPlan::FULL,
-        &target,
-        &Uncancellable,
-        |_| {},
-    );
-    target.take()
+    full_into(scene, settings, SharedFrame::new())
 }
 
 /// [`render_frame`], with an error instead of an abort where the frame does not fit in
@@ -384,15 +375,13 @@ pub fn try_render_frame(
     settings: &RenderSettings,
 ) -> Result<Frame, crate::memory::OutOfMemory> {
     let target = SharedFrame::try_sized(settings.width, settings.height)?;
-    let Ok(()) = render(
-        scene,
-        settings,
-        RenderPlan::FULL,
-        &target,
-        &Uncancellable,
-        |_| {},
-    );
-    Ok(target.take())
+    Ok(full_into(scene, settings, target))
+}
+
+fn full_into(scene: &CompiledScene, settings: &RenderSettings, target: SharedFrame) -> Frame {
+    let plan = RenderPlan::FULL;
+    let Ok(()) = render(scene, settings, plan, &target, &Uncancellable, |_| {});
+    target.take()
 }
 
 /// The grid points of a tile's pass not traced before, in 4×2 neighbourhoods (two rows, four
