@@ -10,6 +10,7 @@ mod inspect;
 mod limits;
 pub mod mistakes;
 mod object_rays;
+mod plan;
 mod progressive;
 mod rule_gap;
 mod shade;
@@ -23,10 +24,8 @@ pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
 pub use mistakes::{Mistake, Variant};
 pub use object_rays::{ObjectRays, ObjectT};
-pub use progressive::{
-    Cancel, Cancelled, PassInfo, Passes, RenderPlan, SharedFrame, Tracing, Uncancellable, render,
-    render_frame, try_render_frame,
-};
+pub use plan::{Cancel, Cancelled, Passes, RenderPlan, Tracing, Uncancellable};
+pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_frame};
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};

@@ -7,7 +7,7 @@
 //! at once in the coarse ones (cheap to trace, dear to write); a cancel flag stops the work
 //! within one tile.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -17,20 +17,13 @@ use super::camera::PixelRays;
 use super::compile::CompiledScene;
 use super::cull::TileCull;
 use super::frame::{Frame, Sample, write_sample};
+use super::plan::{Cancel, RenderPlan, Schedule, Tracing, Uncancellable};
 use super::shade::shade_fast;
 use super::shade_lanes::shade_packet;
 use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
 const TILE: u32 = 64;
-const SCALES: [u32; 4] = [8, 4, 2, 1];
-
-/// After a coarse pass, the render goes straight to the full-resolution pass when the rays
-/// that pass has left would take less than this at the coarse pass's time per ray. That time
-/// overstates a full pass's several times over (sparse packets, the whole frame written for
-/// few rays), so the full image then follows within some tens of milliseconds, where the
-/// finer previews would barely show and cost a seventh to a third of the render (docs/perf.md).
-const STRAIGHT_TO_FULL_BELOW: Duration = Duration::from_millis(250);
 
 /// A frame being filled by a render and read by others (the GUI) while it fills.
 #[derive(Debug)]
@@ -101,21 +94,6 @@ pub struct PassInfo {
     pub scale: u32,
     /// Time since the render started.
     pub elapsed: Duration,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Cancelled;
-
-/// How primary rays reach the scene. The two give the same image bit for bit (tested on every
-/// course and perf scene); `Packets` is what every render uses, `SingleRays` is there to
-/// prove that and to measure the difference.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Tracing {
-    /// Eight neighbouring pixels at a time (`CompiledScene::intersect8`: one packet for a
-    /// one-mesh scene, else one by one), shaded one by one.
-    #[default]
-    Packets,
-    SingleRays,
 }
 
 /// Traces one pixel's ray and shades it into `dst`.
@@ -248,97 +226,6 @@ fn store_sample(
             f32::INFINITY,
             u32::MAX,
         ),
-    }
-}
-
-/// Which passes a render makes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Passes {
-    /// Coarse passes (one ray per 8×8 block, 4×4, 2×2) then every pixel; straight to the
-    /// full pass when the first is quick.
-    #[default]
-    Progressive,
-    /// Only the first two coarse passes: what the editor renders while the mouse drags the
-    /// view, refining once it stops.
-    Coarse,
-    /// One full-resolution pass.
-    Full,
-}
-
-/// What a render does: its passes and how its primary rays are traced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RenderPlan {
-    pub passes: Passes,
-    pub tracing: Tracing,
-}
-
-impl RenderPlan {
-    pub const PROGRESSIVE: RenderPlan = RenderPlan {
-        passes: Passes::Progressive,
-        tracing: Tracing::Packets,
-    };
-    pub const COARSE: RenderPlan = RenderPlan {
-        passes: Passes::Coarse,
-        tracing: Tracing::Packets,
-    };
-    pub const FULL: RenderPlan = RenderPlan {
-        passes: Passes::Full,
-        tracing: Tracing::Packets,
-    };
-
-    /// The same plan with its primary rays traced as `tracing` says.
-    pub fn traced(self, tracing: Tracing) -> RenderPlan {
-        RenderPlan { tracing, ..self }
-    }
-
-    fn schedule(&self) -> Schedule<'static> {
-        let (scales, straight_to_full_below): (&[u32], _) = match self.passes {
-            Passes::Progressive => (&SCALES, Some(STRAIGHT_TO_FULL_BELOW)),
-            Passes::Coarse => (&SCALES[..2], None),
-            Passes::Full => (&[1], None),
-        };
-        Schedule {
-            scales,
-            straight_to_full_below,
-            tracing: self.tracing,
-        }
-    }
-}
-
-/// A plan's passes spelt out (tests give their own).
-#[derive(Clone, Copy, Debug)]
-struct Schedule<'a> {
-    scales: &'a [u32],
-    /// Skip to the full pass when a pass took less than this.
-    straight_to_full_below: Option<Duration>,
-    tracing: Tracing,
-}
-
-/// What may stop a render between tiles: a flag (`AtomicBool`: `Err(Cancelled)` promptly
-/// once it is set) or nothing ([`Uncancellable`]: its error type is empty, so a caller
-/// writes `let Ok(()) = render(…)` and discards nothing).
-pub trait Cancel: Sync {
-    type Stop: Send;
-    fn stop(&self) -> Option<Self::Stop>;
-}
-
-impl Cancel for AtomicBool {
-    type Stop = Cancelled;
-    #[inline]
-    fn stop(&self) -> Option<Cancelled> {
-        self.load(Ordering::Relaxed).then_some(Cancelled)
-    }
-}
-
-/// A render nothing stops.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Uncancellable;
-
-impl Cancel for Uncancellable {
-    type Stop = std::convert::Infallible;
-    #[inline]
-    fn stop(&self) -> Option<std::convert::Infallible> {
-        None
     }
 }
 
@@ -665,7 +552,9 @@ fn render_scales<C: Cancel>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::plan::{Cancelled, SCALES, STRAIGHT_TO_FULL_BELOW};
     use crate::{MeshCache, load_scene};
+    use std::sync::atomic::AtomicBool;
 
     /// What the viewport shows after each pass: every pixel holds the sample of its block's
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::NormalTransform;
 use super::RenderSettings;
 use super::compile::{CompiledScene, Hit, Object, Shape};
-use super::progressive::Cancelled;
+use super::plan::Cancelled;
 use super::similitude::similitude_within;
 use crate::geometry::Transform;
 
