@@ -546,7 +546,11 @@ pub fn report_text(r: &PixelReport) -> String {
         ));
     }
     let label = if black { "colour" } else { "sum" };
-    out.push(format!("  {label:<23}{} -> bytes {:?}", v3(r.color), r.rgb8));
+    out.push(format!(
+        "  {label:<23}{} -> bytes {:?}",
+        v3(r.color),
+        r.rgb8
+    ));
     out.push(images_line(&r.images));
     out.join("\n") + "\n"
 }

@@ -48,7 +48,7 @@ pub struct InspectArgs {
     pub shade_back: bool,
     /// The depth image's range, as the course line's `-depth MIN MAX`: the depth byte is printed
     /// for it.
-    #[arg(long, num_args = 2, value_names = ["MIN", "MAX"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 2, value_names = ["MIN", "MAX"], allow_hyphen_values = true)]
     pub depth: Option<Vec<OsString>>,
 }
 

@@ -279,7 +279,10 @@ Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 3 } }",
             };
             let frame = render_frame(&c, &settings);
             let story = inspect_pixel(&s, &c, &settings, 10, 10);
-            let h = story.hit.as_ref().expect("inside the sphere every ray hits");
+            let h = story
+                .hit
+                .as_ref()
+                .expect("inside the sphere every ray hits");
             assert!(h.shade.back_facing);
             assert_eq!(h.shade.ambient_term, Vec3::new(0.1, 0.4, 0.4));
             let e = story.color();
