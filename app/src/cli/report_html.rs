@@ -81,9 +81,10 @@ pub fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// Text for HTML: the five special characters as entities, control characters (but newline
-/// and tab) as visible escapes.
+/// Text for HTML: control characters escaped as in every other output (`\x1b`), then the
+/// five special characters as entities.
 pub fn escape_html(text: &str) -> String {
+    let text = crate::io::escape_text(text);
     let mut out = String::with_capacity(text.len());
     for ch in text.chars() {
         match ch {
@@ -92,10 +93,6 @@ pub fn escape_html(text: &str) -> String {
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
             '\'' => out.push_str("&#39;"),
-            '\n' | '\t' => out.push(ch),
-            c if c.is_control() => {
-                let _ = write!(out, "\\u{{{:x}}}", c as u32);
-            }
             c => out.push(c),
         }
     }
@@ -178,9 +175,9 @@ pub fn report_html(
         } else {
             "bad"
         };
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<section id=\"line{}\" class=\"{class}\"><h2>line {}: <code>{}</code></h2>\n",
+            "<section id=\"line{}\" class=\"{class}\"><h2>line {}: <code>{}</code></h2>",
             r.number,
             r.number,
             escape_html(&r.text)
@@ -201,7 +198,7 @@ pub fn report_html(
             );
             if let Some(p) = &i.pictures {
                 // Small images shown at least 200 px wide, pixels kept sharp.
-                let w = p.width.max(200).min(400);
+                let w = p.width.clamp(200, 400);
                 for (caption, data) in [
                     ("yours", &p.mine),
                     ("reference", &p.reference),
@@ -251,7 +248,7 @@ mod tests {
     fn html_escapes_markup_and_control_bytes() {
         assert_eq!(
             escape_html("<a href=\"x\">&'\u{1b}[31m\n"),
-            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;\\u{1b}[31m\n"
+            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;\\x1b[31m\n"
         );
     }
 }
