@@ -359,3 +359,92 @@ fn batch_usage_errors_exit_2() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     assert!(text(&o.stderr).contains("nothing.txt"));
 }
+
+/// The handout as it is: every line rendered by tracelab into `images/`, then the colour
+/// image of four lines (scene2_01 to scene2_04) replaced by tracelab's pixel-corner mistake.
+/// With TRACELAB_BATCH_KEEP=DIR the folder and its report are left in DIR (the README's
+/// screenshot is made from it).
+#[test]
+#[ignore = "needs ../shared/mit6837 (TRACELAB_COURSE_DIR)"]
+fn the_handout_folder_with_pixel_corners_is_judged_line_by_line() {
+    let course = common::course_dir();
+    let d = match std::env::var_os("TRACELAB_BATCH_KEEP") {
+        Some(k) => {
+            let k = PathBuf::from(k);
+            let _ = std::fs::remove_dir_all(&k);
+            std::fs::create_dir_all(&k).expect("keep dir");
+            k
+        }
+        None => common::temp_dir("batch", "handout"),
+    };
+    let img = d.join("images");
+    std::fs::create_dir_all(&img).expect("images");
+    let scenes = course.join("scenes");
+    // Rendered where the scenes are named: the line's names are plain file names.
+    let commands = std::fs::read_to_string(course.join("commands.txt")).expect("commands");
+    for l in commands.lines().filter(|l| l.starts_with("raytracer ")) {
+        let mut args: Vec<String> = l.split_whitespace().skip(1).map(String::from).collect();
+        for a in args.iter_mut() {
+            if a.ends_with(".txt") {
+                *a = scenes.join(&*a).to_string_lossy().into_owned();
+            }
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = tracelab(&args, &img);
+        assert!(o.status.success(), "{l}: {}", text(&o.stderr));
+    }
+    for (scene, output) in [
+        ("scene2_01_diffuse.txt", "output2_01.png"),
+        ("scene2_02_ambient.txt", "output2_02.png"),
+        ("scene2_03_colored_lights.txt", "output2_03.png"),
+        ("scene2_04_perspective.txt", "output2_04.png"),
+    ] {
+        let s = tracelab_core::load_scene(&scenes.join(scene), &mut MeshCache::new())
+            .scene
+            .expect("scene");
+        let compiled = CompiledScene::new(&s);
+        let variant = Some(Variant::one(Mistake::PixelCorners));
+        let settings = RenderSettings {
+            variant,
+            ..RenderSettings::new(200, 200)
+        };
+        let frame = render_variant(&compiled, &settings);
+        let bytes = variant_rgb8(&compiled, &frame, variant, View::Color, (0.0, 1.0));
+        image::RgbImage::from_raw(200, 200, bytes)
+            .expect("size")
+            .save(img.join(output))
+            .expect("save");
+    }
+    let cmds = course.join("commands.txt");
+    let o = tracelab(
+        &[
+            "diff",
+            "--batch",
+            cmds.to_str().expect("utf-8"),
+            "--images",
+            "images",
+            "--report",
+            "report.html",
+        ],
+        &d,
+    );
+    let out = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}{}", text(&o.stderr));
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 45, "44 images and the total:\n{out}");
+    let differ: Vec<&&str> = lines
+        .iter()
+        .filter(|l| l.contains("does not match"))
+        .collect();
+    assert!(
+        differ
+            .iter()
+            .all(|l| ["output2_01", "output2_02", "output2_03", "output2_04"]
+                .iter()
+                .any(|o| l.contains(o))),
+        "only the four replaced images differ:\n{out}"
+    );
+    assert!(!differ.is_empty(), "{out}");
+    let html = std::fs::read_to_string(d.join("report.html")).expect("report");
+    assert!(html.contains(&format!("({})", Mistake::PixelCorners.name())));
+}

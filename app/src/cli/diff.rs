@@ -47,7 +47,20 @@ pub const LONG_ABOUT: &str = "Compare your ray tracer's image with tracelab's re
     Pixel coordinates are x from the left, row from the top (as in tracelab inspect).\n\
     Exit status: 0 when every image matches, 3 when one does not, 4 when every image matches but a \
     heat map could not be written, 5 when one does not match and a heat map could not be written \
-    (the verdicts are printed either way), 1 for a file that cannot be read, 2 for a usage error.";
+    (the verdicts are printed either way), 1 for a file that cannot be read, 2 for a usage error.\n\n\
+    A whole class folder: tracelab diff --batch commands.txt --images DIR [--scenes DIR] [--report FILE] \
+    judges every `raytracer` line of the handout's commands file (as it is: blank lines and # comments \
+    skipped, any other line skipped with a warning naming it; at most 1000 lines, 1 MiB) against the \
+    images in DIR that its -output, -normals and -depth name (names inside DIR only). The scenes are \
+    read from --scenes, else scenes/ beside the commands file, else its folder. It prints one line per \
+    image (\"commands.txt:12: colour DIR/output2_05.png: … matches\"; a missing image, a link to \
+    nothing, a FIFO or a folder does not match), then the total, and writes one self-contained HTML \
+    report (images inlined: yours, the reference and the heat map side by side, the verdicts, the \
+    diagnosis and the regions of each line) to --report FILE (never an input) or tracelab-report.html \
+    (another name where that is a link or an input); no heat map files. Exit status: 0 when every \
+    image matches, 3 when one does not, 1 when a line could not be judged (its flags or its scene; \
+    the others are still judged and the report written) or the report could not be written, 2 for \
+    a usage error.";
 
 #[derive(clap::Args, Debug)]
 pub struct DiffArgs {

@@ -107,7 +107,7 @@ section.ok{border-left-color:#2a2}section.bad{border-left-color:#d33}section.err
 .ok b{color:#2a2}.bad b{color:#d33}.verdict{margin:.2em 0}\
 figure{display:inline-block;margin:.3em .6em .3em 0;text-align:center}\
 figcaption{font-size:.8em;color:#555}img{image-rendering:pixelated;border:1px solid #ccc}\
-table.sum{border-collapse:collapse}table.sum td{padding:.1em .6em;border-bottom:1px solid #eee}";
+table.sum{border-collapse:collapse}table.sum td{padding:.1em .6em;border-bottom:1px solid #eee}table.sum td:first-child{white-space:nowrap}";
 
 /// The whole page.
 pub fn report_html(
