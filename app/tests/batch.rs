@@ -448,3 +448,30 @@ fn the_handout_folder_with_pixel_corners_is_judged_line_by_line() {
     let html = std::fs::read_to_string(d.join("report.html")).expect("report");
     assert!(html.contains(&format!("({})", Mistake::PixelCorners.name())));
 }
+
+#[test]
+fn pictures_of_an_image_over_a_million_pixels_are_not_inlined() {
+    let d = class(
+        "big",
+        &["raytracer -input s.txt -size 1025 1024 -output big.png".into()],
+    );
+    let scene = d.join("scenes/s.txt");
+    let o = tracelab(
+        &[
+            "-input",
+            scene.to_str().expect("utf-8"),
+            "-size",
+            "1025",
+            "1024",
+            "-output",
+            "big.png",
+        ],
+        &d.join("images"),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = batch(&d, &["--report", "r.html"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let html = std::fs::read_to_string(d.join("r.html")).expect("report");
+    assert!(html.contains("pictures not inlined: 1025×1024 is over 1048576 pixels"));
+    assert!(!html.contains("data:image/png"));
+}

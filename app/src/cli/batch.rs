@@ -20,6 +20,10 @@ pub const COMMANDS_CAP: u64 = 1 << 20;
 /// The most `raytracer` lines judged in one run.
 pub const LINES_CAP: usize = 1000;
 const DEFAULT_REPORT: &str = "tracelab-report.html";
+/// The largest image whose pictures are inlined in the report, and the most base64 the
+/// report holds in all: the page stays one a browser opens, and memory stays bounded.
+pub const INLINE_PIXELS: u64 = 1024 * 1024;
+pub const INLINE_BYTES: usize = 256 << 20;
 
 /// One `raytracer` line of the commands file.
 struct CourseLine {
@@ -215,8 +219,9 @@ pub fn run_batch(a: &DiffArgs, commands: &Path, c: &Criterion) -> anyhow::Result
     let mut rows = Vec::new();
     let mut summary = String::new();
     let (mut failed_lines, mut images_total, mut images_ok) = (0, 0, 0);
+    let mut inlined = 0;
     for p in planned {
-        let row = judge_planned(p, a, c, &mut plan);
+        let row = judge_planned(p, a, c, &mut plan, &mut inlined);
         for img in &row.images {
             images_total += 1;
             images_ok += usize::from(img.ok);
@@ -278,7 +283,13 @@ pub fn run_batch(a: &DiffArgs, commands: &Path, c: &Criterion) -> anyhow::Result
 }
 
 /// One line judged into the report's row; any failure is the row's error, never the run's.
-fn judge_planned(p: Planned, a: &DiffArgs, c: &Criterion, plan: &mut OutputPlan) -> LineRow {
+fn judge_planned(
+    p: Planned,
+    a: &DiffArgs,
+    c: &Criterion,
+    plan: &mut OutputPlan,
+    inlined: &mut usize,
+) -> LineRow {
     let mut row = LineRow {
         number: p.line.number,
         text: p.line.text,
@@ -307,6 +318,7 @@ fn judge_planned(p: Planned, a: &DiffArgs, c: &Criterion, plan: &mut OutputPlan)
                 verdict: format!("{what} {}: {why}: does not match", path.display()),
                 ok: false,
                 pictures: None,
+                note: None,
             }),
         }
     }
@@ -314,7 +326,7 @@ fn judge_planned(p: Planned, a: &DiffArgs, c: &Criterion, plan: &mut OutputPlan)
         return row;
     }
     match judge_line(&job, &students, c, a.regions, plan) {
-        Ok(j) => fill(&mut row, &j),
+        Ok(j) => fill(&mut row, &j, inlined),
         Err(e) => row.error = Some(e.to_string()),
     }
     row
@@ -326,14 +338,34 @@ fn strip_path(message: &str, path: &Path) -> String {
     message.strip_prefix(&prefix).unwrap_or(message).to_string()
 }
 
-fn fill(row: &mut LineRow, j: &Judgement) {
+/// The line's verdicts and pictures into its row; pictures only within the inline caps.
+fn fill(row: &mut LineRow, j: &Judgement, inlined: &mut usize) {
     row.diagnosis = j.diagnosis.clone();
     row.regions = j.regions.clone();
     for v in &j.verdicts {
+        let (mut pictures, mut note) = (None, None);
+        if let Some(d) = &v.decoded {
+            let (w, h) = d.mine.dimensions();
+            if u64::from(w) * u64::from(h) > INLINE_PIXELS {
+                note = Some(format!(
+                    "pictures not inlined: {w}×{h} is over {INLINE_PIXELS} pixels (tracelab diff on this line writes its heat map)"
+                ));
+            } else if *inlined > INLINE_BYTES {
+                note = Some(format!(
+                    "pictures not inlined: the report already holds {} MiB of them",
+                    INLINE_BYTES >> 20
+                ));
+            } else {
+                let p = Pictures::new(d);
+                *inlined += p.mine.len() + p.reference.len() + p.heat.len();
+                pictures = Some(p);
+            }
+        }
         row.images.push(ImageRow {
             verdict: v.text.clone(),
             ok: v.ok,
-            pictures: v.decoded.as_ref().map(|d| Pictures::new(d)),
+            pictures,
+            note,
         });
     }
 }

@@ -38,6 +38,8 @@ pub struct ImageRow {
     pub ok: bool,
     /// `None` when the image was missing, unreadable or of the wrong size.
     pub pictures: Option<Pictures>,
+    /// Why pictures that could be shown are not (too large to inline).
+    pub note: Option<String>,
 }
 
 pub struct LineRow {
@@ -196,6 +198,9 @@ pub fn report_html(
                 if i.ok { "✓" } else { "✗" },
                 escape_html(&i.verdict)
             );
+            if let Some(n) = &i.note {
+                let _ = writeln!(h, "<p>{}</p>", escape_html(n));
+            }
             if let Some(p) = &i.pictures {
                 // Small images shown at least 200 px wide, pixels kept sharp.
                 let w = p.width.clamp(200, 400);
