@@ -153,6 +153,12 @@ fn a_mistake_a_missing_image_and_junk_lines_are_each_reported() {
         out.contains("commands.txt:4: colour images/out3.png: 0 of 3,600"),
         "{out}"
     );
+    let line4: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("commands.txt:4: "))
+        .map(|l| l.split(' ').nth(1).unwrap_or_default())
+        .collect();
+    assert_eq!(line4, ["colour", "normals", "depth"], "in the line's order");
     assert!(
         out.contains("commands.txt:5: colour images/out4.png: missing"),
         "{out}"

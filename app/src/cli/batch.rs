@@ -307,27 +307,36 @@ fn judge_planned(
     };
     let colour = job.output.clone().unwrap_or_default();
     let mut students: Vec<Student> = Vec::new();
-    for (what, path, view, depth) in wanted_images(&job, &colour) {
+    // The images that cannot be read, by their place on the line (colour, normals, depth).
+    let mut unread = Vec::new();
+    for (k, (what, path, view, depth)) in wanted_images(&job, &colour).into_iter().enumerate() {
         let why = unreadable(path).map(Err).unwrap_or_else(|| {
             read_student(what, path, view, depth, (job.width, job.height))
                 .map_err(|e| strip_path(&e.to_string(), path))
         });
         match why {
             Ok(s) => students.push(s),
-            Err(why) => row.images.push(ImageRow {
-                verdict: format!("{what} {}: {why}: does not match", path.display()),
-                ok: false,
-                pictures: None,
-                note: None,
-            }),
+            Err(why) => unread.push((
+                k,
+                ImageRow {
+                    verdict: format!("{what} {}: {why}: does not match", path.display()),
+                    ok: false,
+                    pictures: None,
+                    note: None,
+                },
+            )),
         }
     }
-    if students.is_empty() {
-        return row;
+    if !students.is_empty() {
+        match judge_line(&job, &students, c, a.regions, plan) {
+            Ok(j) => fill(&mut row, &j, inlined),
+            Err(e) => row.error = Some(e.to_string()),
+        }
     }
-    match judge_line(&job, &students, c, a.regions, plan) {
-        Ok(j) => fill(&mut row, &j, inlined),
-        Err(e) => row.error = Some(e.to_string()),
+    // Back in the line's order.
+    for (k, r) in unread {
+        let at = k.min(row.images.len());
+        row.images.insert(at, r);
     }
     row
 }
