@@ -5,7 +5,9 @@
 
 use glam::{DMat3, DMat4, Vec3};
 use serde::Serialize;
-use tracelab_core::render::{Breaks, HitStory, RayStory, SimilitudeTest, quantize, similitude};
+use tracelab_core::render::{
+    Breaks, HitStory, RayStory, SimilitudeTest, depth_shade, quantize, similitude,
+};
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
 
 use crate::node_label::node_label;
@@ -28,6 +30,32 @@ pub struct PixelReport {
     pub color: [f32; 3],
     /// The image's bytes for that colour: ⌊c·255⌋ clamped, as the course's Image writes.
     pub rgb8: [u8; 3],
+    /// The bytes each of the course's images holds at this pixel.
+    pub images: ImageBytes,
+}
+
+/// What the `-output`, `-normals` and `-depth` images hold at the pixel, so a student need
+/// not turn a normal or a t into bytes by hand.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImageBytes {
+    /// The colour image: the same as `rgb8`.
+    pub color: [u8; 3],
+    /// The normal image: ⌊|n|·255⌋ of the world normal by the rule (before any shade-back
+    /// flip); black for a miss.
+    pub normals: [u8; 3],
+    /// The depth image for the range given (`--depth MIN MAX`, a course line's `-depth`);
+    /// `None` (JSON null) without one.
+    pub depth: Option<DepthBytes>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DepthBytes {
+    pub min: f32,
+    pub max: f32,
+    /// The shade (max − t)/(max − min) clamped to [0, 1], of the t the renderer kept.
+    pub shade: f32,
+    /// ⌊shade·255⌋ in each channel; black for a miss.
+    pub bytes: [u8; 3],
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -312,6 +340,32 @@ pub fn hit_report(scene: &Scene, h: &HitStory, normal_rule: NormalTransform) -> 
     }
 }
 
+fn quantize3(v: Vec3) -> [u8; 3] {
+    [quantize(v.x), quantize(v.y), quantize(v.z)]
+}
+
+impl PixelReport {
+    /// The depth image's bytes for the range `min`..`max`, as `Frame::rgb8` makes them.
+    pub fn with_depth_range(mut self, min: f32, max: f32) -> Self {
+        let shade = self
+            .hit
+            .as_ref()
+            .map_or(0.0, |h| depth_shade(h.t.used, min, max));
+        let g = if self.hit.is_some() {
+            quantize(shade)
+        } else {
+            0
+        };
+        self.images.depth = Some(DepthBytes {
+            min,
+            max,
+            shade,
+            bytes: [g; 3],
+        });
+        self
+    }
+}
+
 /// The report of a story traced with `settings` in `scene`.
 pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) -> PixelReport {
     let color = story.color();
@@ -334,7 +388,15 @@ pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) 
             .map(|h| hit_report(scene, h, story.normal_transform)),
         background: a3(story.background),
         color: a3(color),
-        rgb8: [quantize(color.x), quantize(color.y), quantize(color.z)],
+        rgb8: quantize3(color),
+        images: ImageBytes {
+            color: quantize3(color),
+            normals: story
+                .hit
+                .as_ref()
+                .map_or([0; 3], |h| quantize3(h.shade.normal.abs())),
+            depth: None,
+        },
     }
 }
 
@@ -413,6 +475,7 @@ pub fn report_text(r: &PixelReport) -> String {
             v3(r.background)
         ));
         out.push(format!("colour {} -> bytes {:?}", v3(r.color), r.rgb8));
+        out.push(images_line(&r.images));
         return out.join("\n") + "\n";
     };
     out.push(format!("hit: {} (node {})", h.node.label, h.node.id));
@@ -458,13 +521,23 @@ pub fn report_text(r: &PixelReport) -> String {
         h.normal.angle_degrees
     ));
     let sh = &h.shading;
+    let black = sh.back_facing && !r.settings.shade_back;
     out.push(format!(
         "shading by the {} rule{}: k_d {}",
         sh.normal_rule,
-        if sh.back_facing { " (back-facing)" } else { "" },
+        if black {
+            " (back-facing: drawn black without --shade-back)"
+        } else if sh.back_facing {
+            " (back-facing: the normal flipped toward the eye)"
+        } else {
+            ""
+        },
         v3(sh.diffuse)
     ));
     out.push(format!("  ambient·k_d            {}", v3(sh.ambient)));
+    if black {
+        out.push("  (no terms are added: the pixel is black)".into());
+    }
     for (i, l) in sh.lights.iter().enumerate() {
         out.push(format!(
             "  light {i}: L·N = {:.5}  {}",
@@ -472,12 +545,29 @@ pub fn report_text(r: &PixelReport) -> String {
             v3(l.contribution)
         ));
     }
+    let label = if black { "colour" } else { "sum" };
     out.push(format!(
-        "  sum                    {} -> bytes {:?}",
+        "  {label:<23}{} -> bytes {:?}",
         v3(r.color),
         r.rgb8
     ));
+    out.push(images_line(&r.images));
     out.join("\n") + "\n"
+}
+
+/// "each image here: colour [..], normals [..], depth [..] (range 9 to 11)".
+pub fn images_line(i: &ImageBytes) -> String {
+    let depth = match &i.depth {
+        Some(d) => format!(
+            "depth {:?} (shade {:.5} in the range {} to {})",
+            d.bytes, d.shade, d.min, d.max
+        ),
+        None => "depth: give --depth MIN MAX for its bytes".into(),
+    };
+    format!(
+        "each image here: colour {:?}, normals {:?}, {depth}",
+        i.color, i.normals
+    )
 }
 
 /// One line for a pixel: what the ray hit, at which t, with which normal (for `tracelab diff`).

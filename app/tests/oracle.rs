@@ -345,6 +345,86 @@ fn inspect_text_names_rows_from_the_top_and_refuses_pixels_outside() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+#[test]
+fn inspect_prints_the_bytes_each_image_holds_as_the_render_writes_them() {
+    // Inside a sphere of radius 5: the corners see its back faces, the centre the small
+    // sphere's front. Depth range 2..6 puts the front sphere (t ≈ 2.5) mid-grey.
+    let dir = temp_dir("inspect-bytes");
+    let scene = repo().join("scenes/inside_sphere.txt");
+    let scene = scene.to_str().expect("utf-8");
+    for shade_back in [false, true] {
+        let mut line = vec![
+            "-input", scene, "-size", "30", "30", "-output", "c.png", "-normals", "n.png",
+            "-depth", "2", "6", "d.png",
+        ];
+        if shade_back {
+            line.push("-shade_back");
+        }
+        let o = tracelab(&line, &dir);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let read = |f: &str| image::open(dir.join(f)).expect("image").to_rgb8();
+        let (c, n, d) = (read("c.png"), read("n.png"), read("d.png"));
+        let mut backs = 0;
+        for (x, row) in [(0u32, 0u32), (15, 15), (3, 20), (29, 29), (16, 12)] {
+            let (xs, rs) = (x.to_string(), row.to_string());
+            let mut args = vec![
+                "--size", "30", "30", "--pixel", &xs, &rs, "--depth", "2", "6",
+            ];
+            if shade_back {
+                args.push("--shade-back");
+            }
+            let j = inspect_json("scenes/inside_sphere.txt", &args);
+            let bytes = |v: &Value| -> Vec<u8> {
+                v.as_array()
+                    .expect("bytes")
+                    .iter()
+                    .map(|b| b.as_u64().expect("byte") as u8)
+                    .collect()
+            };
+            let at = |img: &image::RgbImage| img.get_pixel(x, row).0.to_vec();
+            let i = &j["images"];
+            assert_eq!(bytes(&i["color"]), at(&c), "colour at {x},{row}");
+            assert_eq!(bytes(&i["normals"]), at(&n), "normals at {x},{row}");
+            assert_eq!(bytes(&i["depth"]["bytes"]), at(&d), "depth at {x},{row}");
+            assert_eq!(num(&i["depth"]["min"]), 2.0);
+            let back = j["hit"]["shading"]["back_facing"] == true;
+            backs += usize::from(back);
+            if back {
+                // Documented as c_ambient·k_d, back face or not: 0.2 × (0.9, 0.9, 0.6).
+                let amb = vec3(&j["hit"]["shading"]["ambient"]);
+                close(amb, DVec3::new(0.18, 0.18, 0.12), 1e-6, "ambient");
+                assert_eq!(bytes(&i["color"]) == [0, 0, 0], !shade_back);
+            }
+        }
+        // The corners are the big sphere's inside; the centre is the small one's front.
+        assert!((2..5).contains(&backs), "{backs} back faces");
+    }
+    // Text: the same bytes; without --depth, how to get the depth byte.
+    let o = tracelab(
+        &["inspect", scene, "--size", "30", "30", "--pixel", "0", "0"],
+        &repo(),
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "drawn black without --shade-back",
+        "ambient·k_d            (0.18000, 0.18000, 0.12000)",
+        "each image here: colour [0, 0, 0], normals [",
+        "depth: give --depth MIN MAX",
+    ] {
+        assert!(text.contains(want), "{want} missing:\n{text}");
+    }
+    for bad in ["nan", "1e39", "-inf", "x", ""] {
+        let o = tracelab(
+            &[
+                "inspect", scene, "--size", "30", "30", "--pixel", "0", "0", "--depth", "2", bad,
+            ],
+            &repo(),
+        );
+        assert_eq!(o.status.code(), Some(2), "--depth 2 {bad:?}");
+        assert!(stderr(&o).contains("--depth"), "{}", stderr(&o));
+    }
+}
+
 /// Renders the course line with tracelab into `dir` (the "student's" outputs), then runs
 /// `tracelab diff IMAGE -- LINE`.
 fn course_line(scene: &Path) -> Vec<String> {

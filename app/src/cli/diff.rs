@@ -47,12 +47,26 @@ pub const LONG_ABOUT: &str = "Compare your ray tracer's image with tracelab's re
     Pixel coordinates are x from the left, row from the top (as in tracelab inspect).\n\
     Exit status: 0 when every image matches, 3 when one does not, 4 when every image matches but a \
     heat map could not be written, 5 when one does not match and a heat map could not be written \
-    (the verdicts are printed either way), 1 for a file that cannot be read, 2 for a usage error.";
+    (the verdicts are printed either way), 1 for a file that cannot be read, 2 for a usage error.\n\n\
+    A whole class folder: tracelab diff --batch commands.txt --images DIR [--scenes DIR] [--report FILE] \
+    judges every `raytracer` line of the handout's commands file (as it is: blank lines and # comments \
+    skipped, any other line skipped with a warning naming it; at most 1000 lines, 1 MiB) against the \
+    images in DIR that its -output, -normals and -depth name (names inside DIR only). The scenes are \
+    read from --scenes, else scenes/ beside the commands file, else its folder. It prints one line per \
+    image (\"commands.txt:12: colour DIR/output2_05.png: … matches\"; a missing image, a link to \
+    nothing, a FIFO or a folder does not match), then the total, and writes one self-contained HTML \
+    report (images inlined: yours, the reference and the heat map side by side, the verdicts, the \
+    diagnosis and the regions of each line) to --report FILE (never an input) or tracelab-report.html \
+    (another name where that is a link or an input); no heat map files. Exit status: 0 when every \
+    image matches, 3 when one does not, 1 when a line could not be judged (its flags or its scene; \
+    the others are still judged and the report written) or the report could not be written, 2 for \
+    a usage error.";
 
 #[derive(clap::Args, Debug)]
 pub struct DiffArgs {
     /// Your colour image (.png .tga .ppm .bmp).
-    pub image: PathBuf,
+    #[arg(required_unless_present = "batch")]
+    pub image: Option<PathBuf>,
     /// The largest channel difference (of 255) that is not off: the references' own is 2.
     #[arg(long, default_value_t = Criterion::REFERENCES.tolerance)]
     pub tolerance: u8,
@@ -66,11 +80,26 @@ pub struct DiffArgs {
     /// The course's command line, after `--`: -input F -size W H -output F [-normals F] [-depth MIN MAX F] ...
     #[arg(
         last = true,
-        required = true,
+        required_unless_present = "batch",
         allow_hyphen_values = true,
         value_name = "COURSE-COMMAND-LINE"
     )]
     pub course: Vec<OsString>,
+    /// Judge a folder of outputs against every `raytracer` line of the handout's commands
+    /// file (with --images DIR), writing one HTML report.
+    #[arg(long, value_name = "COMMANDS.txt", conflicts_with_all = ["image", "course"], requires = "images")]
+    pub batch: Option<PathBuf>,
+    /// With --batch: the folder holding the images the lines name (-output, -normals, -depth).
+    #[arg(long, value_name = "DIR", requires = "batch")]
+    pub images: Option<PathBuf>,
+    /// With --batch: the folder of the scenes the lines' -input name (default: `scenes/` beside
+    /// the commands file when there is one, else the commands file's folder).
+    #[arg(long, value_name = "DIR", requires = "batch")]
+    pub scenes: Option<PathBuf>,
+    /// With --batch: the HTML report to write (default: tracelab-report.html in the current
+    /// folder, under another name when that one is taken by a link or an input).
+    #[arg(long, value_name = "FILE", requires = "batch")]
+    pub report: Option<PathBuf>,
 }
 
 /// The heat map: pixels not off as the reference dimmed to a quarter in grey, the others
@@ -91,13 +120,13 @@ pub fn heat_map(mine: &RgbImage, reference: &RgbImage, tolerance: u8) -> RgbImag
 }
 
 /// A student's image as read, before the render: its bytes and the size its header claims.
-struct Student<'a> {
-    what: &'static str,
-    path: &'a Path,
-    view: View,
-    depth: (f32, f32),
+pub(super) struct Student<'a> {
+    pub what: &'static str,
+    pub path: &'a Path,
+    pub view: View,
+    pub depth: (f32, f32),
     bytes: Vec<u8>,
-    size: (u32, u32),
+    pub size: (u32, u32),
 }
 
 /// The most bytes read as an image of `w`×`h`: 12 a pixel (an ASCII PPM writes up to
@@ -110,7 +139,7 @@ fn byte_cap(w: u32, h: u32) -> u64 {
 /// Reads the file whole (so a pipe or FIFO works: nothing seeks on it) up to
 /// [`byte_cap`], then the size from the image's header alone: nothing is decoded yet. A
 /// longer file is refused unless its header gives another size (then only that is judged).
-fn read_student<'a>(
+pub(super) fn read_student<'a>(
     what: &'static str,
     path: &'a Path,
     view: View,
@@ -209,7 +238,7 @@ fn write_heat_map(img: &RgbImage, image: &Path, plan: &mut OutputPlan) -> Result
     Ok(chosen)
 }
 
-struct Reference<'a> {
+pub(super) struct Reference<'a> {
     scene: &'a Scene,
     compiled: &'a CompiledScene,
     settings: RenderSettings,
@@ -217,61 +246,48 @@ struct Reference<'a> {
 }
 
 /// One of the student's images of the right size, decoded, with the reference's bytes and
-/// the verdict.
-struct Decoded<'s> {
-    student: &'s Student<'s>,
-    mine: RgbImage,
-    reference: Vec<u8>,
-    ok: bool,
+/// the heat map.
+pub(super) struct Decoded<'s> {
+    pub student: &'s Student<'s>,
+    pub mine: RgbImage,
+    pub reference: Vec<u8>,
+    pub heat: RgbImage,
 }
 
-/// Compares one of the student's images with one view of the reference, printing the
-/// verdict. Returns the decoded image (`None` for a wrong size, which does not match); a heat
-/// map that could not be written is said in the verdict and its reason pushed on `failed`.
-fn check<'s>(
-    c: &Criterion,
-    r: &Reference,
-    s: &'s Student<'s>,
-    plan: &mut OutputPlan,
-    out: &mut String,
-    failed: &mut Vec<String>,
-) -> anyhow::Result<Option<Decoded<'s>>> {
+/// One image of a line judged: the verdict's text (without the heat map's name) and, for an
+/// image of the right size, the pictures.
+pub(super) struct Verdict<'s> {
+    pub student: &'s Student<'s>,
+    pub text: String,
+    pub ok: bool,
+    pub decoded: Option<Decoded<'s>>,
+}
+
+/// Compares one of the student's images with one view of the reference. A wrong size does
+/// not match and is not decoded.
+fn check<'s>(c: &Criterion, r: &Reference, s: &'s Student<'s>) -> anyhow::Result<Verdict<'s>> {
     let (w, h) = (r.frame.width, r.frame.height);
     if s.size != (w, h) {
-        out.push_str(&format!(
-            "{} {}: size {}×{}, but the command line asks for {w}×{h}: does not match\n",
-            s.what,
-            s.path.display(),
-            s.size.0,
-            s.size.1
-        ));
-        return Ok(None);
+        return Ok(Verdict {
+            student: s,
+            text: format!(
+                "{} {}: size {}×{}, but the command line asks for {w}×{h}: does not match",
+                s.what,
+                s.path.display(),
+                s.size.0,
+                s.size.1
+            ),
+            ok: false,
+            decoded: None,
+        });
     }
     let mine = decode(s, (w, h))?;
     let reference = RgbImage::from_raw(w, h, r.frame.rgb8(s.view, s.depth))
         .ok_or_else(|| anyhow::anyhow!("reference image has the wrong size"))?;
     let cmp = compare(&mine, &reference, c.tolerance);
     let ok = c.matches(cmp.off, cmp.total);
-    let map = match write_heat_map(&heat_map(&mine, &reference, c.tolerance), s.path, plan) {
-        Ok(Implicit {
-            path,
-            instead_of: None,
-        }) => format!("heat map {}", path.display()),
-        Ok(Implicit {
-            path,
-            instead_of: Some((wanted, why)),
-        }) => format!(
-            "heat map {} (not {}: {why})",
-            path.display(),
-            wanted.display()
-        ),
-        Err(e) => {
-            failed.push(e);
-            "heat map not written".to_string()
-        }
-    };
-    out.push_str(&format!(
-        "{} {}: {} of {} pixels off by more than {}/255 ({:.2}%; the limit is {}), largest difference {}: {}; {map}\n",
+    let text = format!(
+        "{} {}: {} of {} pixels off by more than {}/255 ({:.2}%; the limit is {}), largest difference {}: {}",
         s.what,
         s.path.display(),
         count(cmp.off),
@@ -281,13 +297,108 @@ fn check<'s>(
         c.limit(),
         cmp.max_difference,
         if ok { "matches" } else { "does not match" },
-    ));
-    Ok(Some(Decoded {
+    );
+    let heat = heat_map(&mine, &reference, c.tolerance);
+    Ok(Verdict {
         student: s,
-        mine,
-        reference: reference.into_raw(),
+        text,
         ok,
-    }))
+        decoded: Some(Decoded {
+            student: s,
+            mine,
+            reference: reference.into_raw(),
+            heat,
+        }),
+    })
+}
+
+/// A line judged: the diagnosis (empty when every image matches), each image's verdict, and
+/// the regions of off pixels with their stories.
+pub(super) struct Judgement<'s> {
+    pub diagnosis: String,
+    pub verdicts: Vec<Verdict<'s>>,
+    pub regions: String,
+}
+
+impl Judgement<'_> {
+    pub fn all_match(&self) -> bool {
+        self.verdicts.iter().all(|v| v.ok)
+    }
+}
+
+/// The reference for `job` rendered and each of `students` judged against it, with the
+/// diagnosis and `keep` regions an image. Mesh files the scene reads are added to `plan`.
+pub(super) fn judge_line<'s>(
+    job: &RenderJob,
+    students: &'s [Student<'s>],
+    c: &Criterion,
+    keep: usize,
+    plan: &mut OutputPlan,
+) -> anyhow::Result<Judgement<'s>> {
+    let (scene, meshes) = load_scene_and_meshes(job.scene.as_deref())?;
+    for m in &meshes {
+        plan.reads(m);
+    }
+    let compiled = CompiledScene::new(&scene);
+    let settings = RenderSettings {
+        shade_back: job.shade_back,
+        normal_transform: job.normal_transform,
+        object_rays: job.object_rays,
+        ..RenderSettings::new(job.width, job.height)
+    };
+    let frame = render_with_progress(&compiled, &settings)?;
+    let r = Reference {
+        scene: &scene,
+        compiled: &compiled,
+        settings,
+        frame: &frame,
+    };
+    let verdicts = students
+        .iter()
+        .map(|s| check(c, &r, s))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let decoded: Vec<&Decoded> = verdicts.iter().filter_map(|v| v.decoded.as_ref()).collect();
+    let mut diagnosis = String::new();
+    if !verdicts.iter().all(|v| v.ok) && !decoded.is_empty() {
+        // The mistake first: it says more than any pixel.
+        let judged: Vec<Judged> = decoded
+            .iter()
+            .map(|d| Judged {
+                what: d.student.what,
+                view: d.student.view,
+                depth: d.student.depth,
+                mine: d.mine.as_raw(),
+                reference: &d.reference,
+            })
+            .collect();
+        let found = diagnose(&scene, &compiled, &settings, &judged, c);
+        diagnosis = diagnosis_text(&found, &judged);
+    }
+    let regions: String = decoded
+        .iter()
+        .map(|d| region_text(d, &r, students, c, keep))
+        .collect();
+    Ok(Judgement {
+        diagnosis,
+        verdicts,
+        regions,
+    })
+}
+
+/// The images a course line names, as (what, path, view, depth range): the colour image at
+/// `colour`, and the line's -normals and -depth files.
+pub(super) fn wanted_images<'j>(
+    job: &'j RenderJob,
+    colour: &'j Path,
+) -> Vec<(&'static str, &'j Path, View, (f32, f32))> {
+    let mut wanted = vec![("colour", colour, View::Color, (0.0, 1.0))];
+    if let Some(n) = &job.normals {
+        wanted.push(("normals", n.as_path(), View::Normals, (0.0, 1.0)));
+    }
+    if let Some((min, max, d)) = &job.depth {
+        wanted.push(("depth", d.as_path(), View::Depth, (*min, *max)));
+    }
+    wanted
 }
 
 /// The t a depth byte `g` encodes: shade in [g/255, (g+1)/255), so t in (t_lo, t_hi].
@@ -406,89 +517,83 @@ fn region_text(
     out
 }
 
-pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
+/// The criterion of `--tolerance` and `--min-match`, checked.
+fn criterion(a: &DiffArgs) -> anyhow::Result<Criterion> {
     if !(0.0..=100.0).contains(&a.min_match) {
         return Err(usage(format!(
             "--min-match {}: expected a percentage from 0 to 100",
             a.min_match
         )));
     }
-    let criterion = Criterion {
+    Ok(Criterion {
         tolerance: a.tolerance,
         min_match: a.min_match,
+    })
+}
+
+pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
+    let criterion = criterion(a)?;
+    if let Some(commands) = &a.batch {
+        return super::batch::run_batch(a, commands, &criterion);
+    }
+    let Some(image) = a.image.as_deref() else {
+        return Err(usage(
+            "diff needs IMAGE -- COURSE-COMMAND-LINE, or --batch COMMANDS.txt --images DIR",
+        ));
     };
+    if a.course.is_empty() {
+        return Err(usage(
+            "diff: the course's command line goes after `--`: tracelab diff IMAGE -- -input SCENE -size W H ...",
+        ));
+    }
     let job: RenderJob = parse_course_args(&a.course)?;
     check_size(job.width, job.height)?;
     let size = (job.width, job.height);
     // Heat maps are invented names: never a file this command reads or the line names.
     let mut plan = OutputPlan::new();
-    plan.reads(&a.image);
+    plan.reads(image);
     if let Some(s) = &job.scene {
         plan.reads(s);
     }
     if let Some(o) = &job.output {
         plan.names(o);
     }
-    let mut wanted = vec![("colour", a.image.as_path(), View::Color, (0.0, 1.0))];
-    if let Some(n) = &job.normals {
-        wanted.push(("normals", n, View::Normals, (0.0, 1.0)));
-    }
-    if let Some((min, max, d)) = &job.depth {
-        wanted.push(("depth", d, View::Depth, (*min, *max)));
-    }
     // Every image is read and its header checked before the (possibly long) render.
     let mut students = Vec::new();
-    for (what, path, view, depth) in wanted {
+    for (what, path, view, depth) in wanted_images(&job, image) {
         plan.reads(path);
         students.push(read_student(what, path, view, depth, size)?);
     }
-    let (scene, meshes) = load_scene_and_meshes(job.scene.as_deref())?;
-    for m in &meshes {
-        plan.reads(m);
-    }
-    let compiled = CompiledScene::new(&scene);
-    let settings = RenderSettings {
-        shade_back: job.shade_back,
-        normal_transform: job.normal_transform,
-        object_rays: job.object_rays,
-        ..RenderSettings::new(job.width, job.height)
-    };
-    let frame = render_with_progress(&compiled, &settings)?;
-    let r = Reference {
-        scene: &scene,
-        compiled: &compiled,
-        settings,
-        frame: &frame,
-    };
-    let mut verdicts = String::new();
+    let j = judge_line(&job, &students, &criterion, a.regions, &mut plan)?;
     let mut failed = Vec::new();
-    let mut all = true;
-    let mut decoded = Vec::new();
-    for s in &students {
-        let d = check(&criterion, &r, s, &mut plan, &mut verdicts, &mut failed)?;
-        all &= d.as_ref().is_some_and(|d| d.ok);
-        decoded.extend(d);
+    let mut out = j.diagnosis.clone();
+    for v in &j.verdicts {
+        out.push_str(&v.text);
+        if let Some(d) = &v.decoded {
+            let map = match write_heat_map(&d.heat, v.student.path, &mut plan) {
+                Ok(Implicit {
+                    path,
+                    instead_of: None,
+                }) => format!("heat map {}", path.display()),
+                Ok(Implicit {
+                    path,
+                    instead_of: Some((wanted, why)),
+                }) => format!(
+                    "heat map {} (not {}: {why})",
+                    path.display(),
+                    wanted.display()
+                ),
+                Err(e) => {
+                    failed.push(e);
+                    "heat map not written".to_string()
+                }
+            };
+            out.push_str(&format!("; {map}"));
+        }
+        out.push('\n');
     }
-    let mut out = String::new();
-    if !all && !decoded.is_empty() {
-        // The mistake first: it says more than any pixel.
-        let judged: Vec<Judged> = decoded
-            .iter()
-            .map(|d| Judged {
-                what: d.student.what,
-                view: d.student.view,
-                depth: d.student.depth,
-                mine: d.mine.as_raw(),
-                reference: &d.reference,
-            })
-            .collect();
-        let found = diagnose(&scene, &compiled, &settings, &judged, &criterion);
-        out.push_str(&diagnosis_text(&found, &judged));
-    }
-    out.push_str(&verdicts);
-    for d in &decoded {
-        out.push_str(&region_text(d, &r, &students, &criterion, a.regions));
-    }
+    out.push_str(&j.regions);
+    let all = j.all_match();
     // Paths and node labels (an `obj_file` name) are the user's text: escaped.
     write_stdout_text(&out)?;
     if !failed.is_empty() {

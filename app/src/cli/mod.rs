@@ -6,6 +6,7 @@
 //! `crate::exit`).
 
 mod animate;
+mod batch;
 mod course;
 mod diagnose;
 mod diff;
@@ -16,6 +17,7 @@ mod mistyped;
 mod progress;
 mod regions;
 mod render;
+mod report_html;
 mod values;
 
 use std::borrow::Cow;

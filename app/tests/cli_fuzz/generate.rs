@@ -459,6 +459,46 @@ fn inspect_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
         let v = ctx.pick(rng, "incorrect|correct", "z");
         g.push(group(vec![plain("--normal-transform"), plain(v)]));
     }
+    if rng.one_in(4) {
+        let min = ctx.pick(rng, FLOAT_OK, FLOAT_BAD);
+        let max = ctx.pick(rng, FLOAT_OK, FLOAT_BAD);
+        g.push(group(vec![plain("--depth"), plain(min), plain(max)]));
+    }
+    g
+}
+
+/// `diff --batch COMMANDS --images DIR --report F`: the commands file is any input (a scene
+/// is a file of junk lines), the folder a working or hostile one; the report is always named
+/// (the invented default would land in the working folder).
+fn batch_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
+    let commands = if ctx.hostile(rng) {
+        image_in_path(rng, ctx)
+    } else {
+        scene_path(rng, ctx)
+    };
+    let images = ctx.pick(
+        rng,
+        ".|sub",
+        "missing|mine.png|pipe.png|loop_a|dangling.png|",
+    );
+    let mut g = vec![
+        group(vec![plain("--batch"), named(commands, Role::Input)]),
+        group(vec![plain("--images"), plain(images)]),
+        kept(vec![
+            plain("--report"),
+            named(image_out_path(rng, ctx), Role::Output),
+        ]),
+    ];
+    if rng.one_in(3) {
+        let v = ctx.pick(rng, "0|8|255", "256|-1||NaN");
+        g.push(group(vec![plain("--tolerance"), plain(v)]));
+    }
+    if rng.one_in(4) {
+        g.push(group(vec![
+            plain("--scenes"),
+            plain(ctx.pick(rng, ".", "missing|")),
+        ]));
+    }
     g
 }
 
@@ -703,6 +743,12 @@ pub fn generate(k: u64, ctx: &Ctx) -> Case {
         Family::Inspect => {
             let g = inspect_groups(&mut rng, ctx);
             line(&["inspect"], g, &mut rng)
+        }
+        Family::Diff if rng.one_in(4) => {
+            // The commands file is no handout's: no line names a scene, so no mesh is read.
+            loads_meshes = false;
+            let g = batch_groups(&mut rng, ctx);
+            line(&["diff"], g, &mut rng)
         }
         Family::Diff => {
             let pre = diff_groups(&mut rng, ctx);

@@ -141,7 +141,7 @@ pub fn inspect_pixel(
                 normal_correct,
                 normal_incorrect,
                 normal_angle_degrees: angle.to_degrees(),
-                shade: shade_hit(compiled, &world_ray, &hit, settings),
+                shade: story_shade(compiled, &world_ray, &hit, settings),
             })
         });
     RayStory {
@@ -152,6 +152,22 @@ pub fn inspect_pixel(
         background: compiled.background,
         normal_transform: settings.normal_transform,
     }
+}
+
+/// The shading as the renderer does it, with `ambient_term` = c_ambient·k_d as documented
+/// even where the pixel is drawn black (a back face without shade-back): the student sees
+/// the term they should have, and `color` stays what the image holds.
+fn story_shade(
+    compiled: &CompiledScene,
+    ray: &Ray,
+    hit: &super::compile::Hit,
+    settings: &RenderSettings,
+) -> ShadeInfo {
+    let mut shade = shade_hit(compiled, ray, hit, settings);
+    if shade.back_facing && !settings.shade_back {
+        shade.ambient_term = compiled.ambient * shade.diffuse;
+    }
+    shade
 }
 
 #[cfg(test)]
@@ -234,6 +250,37 @@ Group { numObjects 1
                     "{mode:?} {x},{row}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn a_back_face_without_shade_back_reports_its_ambient_and_is_black() {
+        // The camera inside the sphere sees only back faces.
+        let s = scene(
+            "PerspectiveCamera { center 0 0 0 direction 0 0 -1 up 0 1 0 angle 30 }
+Lights { numLights 1 DirectionalLight { direction 0 0 -1 color 0.5 0.5 0.5 } }
+Background { color 0.1 0.2 0.3 ambientLight 0.2 0.4 0.5 }
+Materials { numMaterials 1 Material { diffuseColor 0.5 1 0.8 } }
+Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 3 } }",
+        );
+        let c = CompiledScene::new(&s);
+        for shade_back in [false, true] {
+            let settings = RenderSettings {
+                shade_back,
+                ..RenderSettings::new(20, 20)
+            };
+            let frame = render_frame(&c, &settings);
+            let story = inspect_pixel(&s, &c, &settings, 10, 10);
+            let h = story
+                .hit
+                .as_ref()
+                .expect("inside the sphere every ray hits");
+            assert!(h.shade.back_facing);
+            assert_eq!(h.shade.ambient_term, Vec3::new(0.1, 0.4, 0.4));
+            let e = story.color();
+            let px = frame.get(10, 10).expect("in frame").color;
+            assert_eq!(px, [quantize(e.x), quantize(e.y), quantize(e.z)]);
+            assert_eq!(px == [0, 0, 0], !shade_back, "{px:?}");
         }
     }
 
