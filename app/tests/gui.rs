@@ -69,7 +69,11 @@ fn edit_save_undo(scene: PathBuf) {
     let mut h = harness(Some(scene.clone()), (48, 48));
     settle(&mut h);
     assert!(
-        h.state().doc.messages.iter().all(|m| m.contains("warning")),
+        h.state()
+            .doc
+            .messages
+            .iter()
+            .all(|m| m.text.contains("warning")),
         "{:?}",
         h.state().doc.messages
     );
@@ -168,7 +172,7 @@ fn syntax_error_shows_its_location_and_keeps_the_scene() {
     step_until(&mut h, 10, "the error", |a| !a.is_loading());
     h.step();
     assert_eq!(h.state().doc.scene, before, "the previous scene stays open");
-    let msg = h.state().doc.messages.join("\n");
+    let msg = h.state().doc.messages.joined();
     assert!(msg.contains("broken.txt:3:"), "{msg}");
     // Shown in the window, with file:line:col.
     let _ = h.get_by_label_contains("broken.txt:3:");
@@ -459,7 +463,10 @@ fn a_missing_obj_is_an_error_on_its_node_not_a_failure_to_open() {
         "the scene opened"
     );
     assert!(
-        app.doc.messages.iter().any(|m| m.contains("nowhere.obj")),
+        app.doc
+            .messages
+            .iter()
+            .any(|m| m.text.contains("nowhere.obj")),
         "{:?}",
         app.doc.messages
     );
@@ -948,7 +955,11 @@ fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() 
     .expect("write");
     h.state_mut().open(&bad);
     step_until(&mut h, 10, "an answer", |a| {
-        a.confirm.is_some() || a.doc.messages.iter().any(|m| m.contains("broken.txt:3:"))
+        a.confirm.is_some()
+            || a.doc
+                .messages
+                .iter()
+                .any(|m| m.text.contains("broken.txt:3:"))
     });
     assert_eq!(
         h.state().confirm,
@@ -1550,7 +1561,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
         before,
         "Save wrote a file with no obj_file"
     );
-    let msg = h.state().doc.messages.join("\n");
+    let msg = h.state().doc.messages.joined();
     assert!(
         msg.contains("not saved")
             && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)),

@@ -8,12 +8,14 @@ use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check
 
 pub mod edit;
 mod error;
+pub mod notice;
 pub mod op_target;
 
 pub use error::{Misfit, OpenError, SaveError};
 
 use crate::io::{Opened, SceneRead, read_scene_file};
 use edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
+use notice::{Level, Notices};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Selection {
@@ -40,7 +42,7 @@ pub struct Document {
     /// Bumped on every change to `scene`; the render worker drops work for older ones.
     pub generation: u64,
     /// Errors and warnings from the last open, save or edit (file:line:col for scene files).
-    pub messages: Vec<String>,
+    pub messages: Notices,
     /// Modification time of `path` when last read or written, to notice outside changes.
     pub disk_stamp: Option<SystemTime>,
     pub mesh_cache: MeshCache,
@@ -76,7 +78,7 @@ impl Document {
             path,
             selection: None,
             generation: 1,
-            messages: Vec::new(),
+            messages: Notices::default(),
             disk_stamp,
             mesh_cache: MeshCache::new(),
             lost_comments: Vec::new(),
@@ -311,7 +313,9 @@ impl Document {
                 let generation = self.generation + 1;
                 *self = Document::new(scene, Some(path));
                 self.mesh_cache = cache;
-                self.messages = messages;
+                for (severity, m) in messages {
+                    self.messages.push(Level::from(severity), m);
+                }
                 self.lost_comments = lost_comments;
                 // Generations stay monotonic across documents: the worker compares them.
                 self.generation = generation;
@@ -319,7 +323,10 @@ impl Document {
             }
             Err(messages) => {
                 self.mesh_cache = cache;
-                self.messages = messages.clone();
+                self.messages.clear();
+                for m in &messages {
+                    self.messages.error(m.clone());
+                }
                 Err(OpenError(messages))
             }
         }

@@ -21,6 +21,7 @@ use crate::gui::lecture;
 use crate::gui::loading::{LoadPurpose, Loading};
 use crate::gui::menu;
 use crate::gui::native_dialog::{Answer, NativeDialog};
+use crate::gui::notifications;
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
 use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
@@ -240,7 +241,7 @@ impl TracelabApp {
             AppCommand::Edit(e) => self.apply(e),
             AppCommand::LoadMesh { node, obj_file } => {
                 if let Err(e) = self.doc.load_mesh(node, obj_file) {
-                    self.doc.messages.push(format!("edit refused: {e}"));
+                    self.doc.messages.error(format!("edit refused: {e}"));
                 }
             }
             AppCommand::DeleteSelected => {
@@ -278,7 +279,7 @@ impl TracelabApp {
                 _ => self
                     .doc
                     .messages
-                    .push("Export animation: select a Transform first".into()),
+                    .warning("Export animation: select a Transform first"),
             },
             AppCommand::StartAnimation(form) => {
                 if self.animation_running.is_none() {
@@ -304,7 +305,7 @@ impl TracelabApp {
             AppCommand::SaveAs(p) => self.save_as(&p),
             AppCommand::ExportDialog => self.show_file_dialog(Purpose::Export),
             AppCommand::Export(p) => match self.export(&p) {
-                Ok(files) => self.doc.messages.push(format!(
+                Ok(files) => self.doc.messages.info(format!(
                     "exported {}",
                     files
                         .iter()
@@ -312,7 +313,7 @@ impl TracelabApp {
                         .collect::<Vec<_>>()
                         .join(", ")
                 )),
-                Err(e) => self.doc.messages.push(e.to_string()),
+                Err(e) => self.doc.messages.error(e.to_string()),
             },
             AppCommand::Reload => self.reload(),
             AppCommand::Quit => self.quit(ctx),
@@ -330,7 +331,7 @@ impl TracelabApp {
                 _ => self
                     .doc
                     .messages
-                    .push("Frame selected: select an object first".into()),
+                    .warning("Frame selected: select an object first"),
             },
             AppCommand::FrameAll => self.frame_node(self.doc.scene.graph.root()),
             AppCommand::AxisView(v) => {
@@ -369,7 +370,7 @@ impl TracelabApp {
             None => self
                 .doc
                 .messages
-                .push("nothing with bounds to frame there (a plane has none)".into()),
+                .warning("nothing with bounds to frame there (a plane has none)"),
         }
     }
 
@@ -385,14 +386,14 @@ impl TracelabApp {
                 self.note = Some((a, Instant::now()));
             }
         } else if let Some(r) = &self.doc.refusal {
-            self.doc.messages.push(format!("edit refused: {r}"));
+            self.doc.messages.error(format!("edit refused: {r}"));
         }
     }
 
     /// Applies an edit through the document (the one place that records undo).
     pub fn apply(&mut self, edit: Edit) {
         if let Err(e) = self.doc.apply(edit) {
-            self.doc.messages.push(format!("edit refused: {e}"));
+            self.doc.messages.error(format!("edit refused: {e}"));
         }
     }
 
@@ -478,7 +479,7 @@ impl TracelabApp {
             self.doc.select(selection);
             self.doc
                 .messages
-                .insert(0, format!("{}: reloaded (changed on disk)", path.display()));
+                .info(format!("{}: reloaded (changed on disk)", path.display()));
         }
         self.recent.retain(|r| r != &path);
         self.recent.insert(0, path);
@@ -566,7 +567,7 @@ impl TracelabApp {
                 true
             }
             Err(e) => {
-                self.doc.messages.push(e.to_string());
+                self.doc.messages.error(e.to_string());
                 false
             }
         }
@@ -721,10 +722,19 @@ impl TracelabApp {
 
     fn menu(&mut self, ui: &mut egui::Ui) {
         let mut out = Vec::new();
+        // Behind a dialog the menus wait too (a Modal blocks them already; the file dialog
+        // is a window, so say it here).
+        let free = self.dialog_up().is_none();
         egui::MenuBar::new().ui(ui, |ui| {
-            ui.menu_button("File", |ui| {
-                menu::button(ui, true, AppCommand::New, &mut out);
-                menu::button(ui, true, AppCommand::OpenDialog, &mut out);
+            ui.add_enabled_ui(free, |ui| self.menu_entries(ui, &mut out));
+        });
+        self.commands.extend(out);
+    }
+
+    fn menu_entries(&self, ui: &mut egui::Ui, out: &mut Vec<AppCommand>) {
+        ui.menu_button("File", |ui| {
+                menu::button(ui, true, AppCommand::New, out);
+                menu::button(ui, true, AppCommand::OpenDialog, out);
                 ui.menu_button("Open recent", |ui| {
                     if self.recent.is_empty() {
                         ui.label("(none yet)");
@@ -735,54 +745,59 @@ impl TracelabApp {
                         }
                     }
                 });
-                menu::button(ui, true, AppCommand::Save, &mut out);
-                menu::button(ui, true, AppCommand::SaveAsDialog, &mut out);
-                menu::button(ui, self.doc.path.is_some(), AppCommand::Reload, &mut out);
-                menu::button(ui, true, AppCommand::ExportDialog, &mut out);
+                menu::button(ui, true, AppCommand::Save, out);
+                menu::button(ui, true, AppCommand::SaveAsDialog, out);
+                menu::button(ui, self.doc.path.is_some(), AppCommand::Reload, out);
+                menu::button(ui, true, AppCommand::ExportDialog, out);
                 let transform = matches!(self.doc.selection, Some(Selection::Node(id)) if matches!(self.doc.scene.graph.get(id).map(|n| &n.kind), Some(NodeKind::Transform(_))));
-                menu::button(ui, transform, AppCommand::AnimationDialog, &mut out)
+                menu::button(ui, transform, AppCommand::AnimationDialog, out)
                     .on_disabled_hover_text("Select a Transform: one of its ops' numbers is swept");
                 ui.separator();
-                menu::button(ui, true, AppCommand::Quit, &mut out);
+                menu::button(ui, true, AppCommand::Quit, out);
             });
-            ui.menu_button("Edit", |ui| {
-                menu::button(ui, self.doc.can_undo(), AppCommand::Undo, &mut out);
-                menu::button(ui, self.doc.can_redo(), AppCommand::Redo, &mut out);
-            });
-            ui.menu_button("Lecture", |ui| {
-                for (i, f) in lecture::FIGURES.iter().enumerate() {
-                    if ui.button(f.caption).on_hover_text(f.look[0]).clicked() {
-                        out.push(AppCommand::OpenLecture(i));
-                        ui.close();
-                    }
-                }
-            });
-            ui.menu_button("View", |ui| {
-                let mut open = self.pixel_inspector_open;
-                if ui.checkbox(&mut open, "Pixel inspector").changed() {
-                    out.push(AppCommand::ShowPixelInspector(open));
-                }
-                ui.separator();
-                let node = matches!(self.doc.selection, Some(Selection::Node(_)));
-                menu::button(ui, node, AppCommand::FrameSelected, &mut out);
-                menu::button(ui, true, AppCommand::FrameAll, &mut out);
-                for v in [navigation::AxisView::Front, navigation::AxisView::Right, navigation::AxisView::Top] {
-                    menu::button(ui, true, AppCommand::AxisView(v), &mut out);
-                }
-                ui.separator();
-                let mut ray = self.ray_panel_open;
-                if ui.checkbox(&mut ray, "Ray panel (in the pixel inspector)").changed() {
-                    out.push(AppCommand::ShowRayPanel(ray));
-                }
-                if menu::button(ui, true, AppCommand::ResetLayout, &mut out)
-                    .on_hover_text("Panels back to their first sizes")
-                    .clicked()
-                {
+        ui.menu_button("Edit", |ui| {
+            menu::button(ui, self.doc.can_undo(), AppCommand::Undo, out);
+            menu::button(ui, self.doc.can_redo(), AppCommand::Redo, out);
+        });
+        ui.menu_button("Lecture", |ui| {
+            for (i, f) in lecture::FIGURES.iter().enumerate() {
+                if ui.button(f.caption).on_hover_text(f.look[0]).clicked() {
+                    out.push(AppCommand::OpenLecture(i));
                     ui.close();
                 }
-            });
+            }
         });
-        self.commands.extend(out);
+        ui.menu_button("View", |ui| {
+            let mut open = self.pixel_inspector_open;
+            if ui.checkbox(&mut open, "Pixel inspector").changed() {
+                out.push(AppCommand::ShowPixelInspector(open));
+            }
+            ui.separator();
+            let node = matches!(self.doc.selection, Some(Selection::Node(_)));
+            menu::button(ui, node, AppCommand::FrameSelected, out);
+            menu::button(ui, true, AppCommand::FrameAll, out);
+            for v in [
+                navigation::AxisView::Front,
+                navigation::AxisView::Right,
+                navigation::AxisView::Top,
+            ] {
+                menu::button(ui, true, AppCommand::AxisView(v), out);
+            }
+            ui.separator();
+            let mut ray = self.ray_panel_open;
+            if ui
+                .checkbox(&mut ray, "Ray panel (in the pixel inspector)")
+                .changed()
+            {
+                out.push(AppCommand::ShowRayPanel(ray));
+            }
+            if menu::button(ui, true, AppCommand::ResetLayout, out)
+                .on_hover_text("Panels back to their first sizes")
+                .clicked()
+            {
+                ui.close();
+            }
+        });
     }
 
     fn messages(&mut self, ui: &mut egui::Ui) {
@@ -810,27 +825,7 @@ impl TracelabApp {
                 }
             });
         }
-        if self.doc.messages.is_empty() {
-            return;
-        }
-        ui.horizontal(|ui| {
-            ui.vertical(|ui| {
-                for m in self.doc.messages.iter().take(8) {
-                    let c = if m.contains("warning:") || m.contains("reloaded") {
-                        ui.visuals().warn_fg_color
-                    } else {
-                        ui.visuals().error_fg_color
-                    };
-                    ui.colored_label(c, m);
-                }
-                if self.doc.messages.len() > 8 {
-                    ui.label(format!("… and {} more", self.doc.messages.len() - 8));
-                }
-            });
-            if ui.button("Dismiss").clicked() {
-                self.doc.messages.clear();
-            }
-        });
+        // The document's notices are drawn over the view (`notifications::ui`).
     }
 
     /// Carries out an action the user agreed to.
@@ -863,7 +858,10 @@ impl TracelabApp {
             .and_then(animation_dialog::Running::poll)
         {
             self.animation_running = None;
-            self.doc.messages.push(msg.unwrap_or_else(|e| e));
+            match msg {
+                Ok(m) => self.doc.messages.info(m),
+                Err(e) => self.doc.messages.error(e),
+            }
         }
         if let Some(form) = &mut self.animation
             && let Some(c) =
@@ -1010,6 +1008,17 @@ impl TracelabApp {
         }
     }
 
+    /// The dialog waiting for an answer, if any: the scene's shortcuts and menus wait for it.
+    pub fn dialog_up(&self) -> Option<menu::Dialog> {
+        if self.confirm.is_some() {
+            Some(menu::Dialog::Confirm)
+        } else if self.dialog.is_some() || self.native.is_some() {
+            Some(menu::Dialog::File)
+        } else {
+            None
+        }
+    }
+
     /// One frame of UI, shared by eframe and tests.
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let t0 = Instant::now();
@@ -1019,7 +1028,7 @@ impl TracelabApp {
 
     fn frame_inner(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
-        let keys = menu::shortcuts(&ctx);
+        let keys = menu::shortcuts(&ctx, self.dialog_up());
         self.commands.extend(keys);
         self.poll_loading();
         self.watch_disk();
@@ -1156,7 +1165,7 @@ impl TracelabApp {
         }
         let mut pick = None;
         let mut size = (1, 1);
-        egui::CentralPanel::default().show(ui, |ui| {
+        let view = egui::CentralPanel::default().show(ui, |ui| {
             let gap = self.worker.with_published(|p| p.and_then(|p| p.normal_gap));
             Viewport::toolbar(ui, &mut self.view, gap);
             if let Some(f) = self.lecture.and_then(|i| lecture::FIGURES.get(i)) {
@@ -1184,6 +1193,7 @@ impl TracelabApp {
                 .viewport
                 .images(ui, &mut self.view, &self.worker, &self.doc, &mut asked);
         });
+        notifications::ui(&ctx, &mut self.doc.messages, view.response.rect);
         self.commands.extend(asked);
         if let Some(p) = pick {
             self.queue(AppCommand::Inspect {

@@ -13,6 +13,7 @@ pub mod lecture;
 pub mod loading;
 pub mod menu;
 pub mod native_dialog;
+pub mod notifications;
 pub mod on_screen;
 pub mod overlays;
 pub mod panels;

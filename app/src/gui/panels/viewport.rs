@@ -11,6 +11,7 @@ use crate::gui::gizmo::Axes;
 use crate::gui::on_screen::OnScreen;
 use crate::gui::overlays;
 use crate::gui::view_tools::ViewTools;
+use crate::gui::widgets::number;
 use crate::render_worker::{Published, RenderWorker};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -249,8 +250,8 @@ impl Viewport {
             ui.checkbox(&mut s.shade_back, "shade back");
             ui.separator();
             // "depth" inside the first value, so no lone label ends a row of the bar.
-            ui.add(egui::DragValue::new(&mut s.depth.0).speed(0.05).prefix("depth min "));
-            ui.add(egui::DragValue::new(&mut s.depth.1).speed(0.05).prefix("max "));
+            number(ui, &mut s.depth.0, |d| d.speed(0.05).prefix("depth min "));
+            number(ui, &mut s.depth.1, |d| d.speed(0.05).prefix("max "));
             ui.separator();
             let mut fixed = s.fixed_size.is_some();
             if ui.checkbox(&mut fixed, "fixed size").changed() {
@@ -262,8 +263,8 @@ impl Viewport {
                 // Whole numbers only: "nan" once parsed, was clamped and became 4096.
                 let parse = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
                 let side = 1..=MAX_IMAGE_SIDE;
-                ui.add(egui::DragValue::new(&mut size.0).range(side.clone()).custom_parser(parse).suffix(" w"));
-                ui.add(egui::DragValue::new(&mut size.1).range(side).custom_parser(parse).suffix(" h"));
+                number(ui, &mut size.0, |d| d.range(side.clone()).custom_parser(parse).suffix(" w"));
+                number(ui, &mut size.1, |d| d.range(side).custom_parser(parse).suffix(" h"));
                 if *size != before {
                     // The same limits as the command line: refuse, keep the last good size, say why.
                     let refused = check_image_size(size.0, size.1).err().map(|e| e.to_string());

@@ -1,0 +1,295 @@
+//! The editor's manners (issue 26): keys that respect dialogs, one undo step per typed
+//! value, Esc that restores. Logic tests with egui_kittest, no GPU needed. Each check has a
+//! positive control: the same key or typing without the dialog does change the scene.
+
+mod common;
+use common::settle;
+use std::path::PathBuf;
+
+use egui::{KeyboardShortcut, Modifiers};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::Vec3;
+use tracelab::document::Selection;
+use tracelab::document::edit::Edit;
+use tracelab::gui::menu::{self, Dialog};
+use tracelab::gui::{AppOptions, Pending, TracelabApp};
+use tracelab_core::{NodeId, NodeKind, TransformOp};
+
+fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: Some(scene),
+                    fixed_size: Some((16, 16)),
+                    ..AppOptions::default()
+                },
+            )
+        });
+    settle(&mut h);
+    h
+}
+
+/// A private copy of `scenes/sheared_sphere.txt` (Ctrl+S writes it).
+fn sheared(tag: &str) -> PathBuf {
+    let dir = common::temp_dir("manners", tag);
+    let p = dir.join("sheared_sphere.txt");
+    std::fs::copy(common::repo().join("scenes/sheared_sphere.txt"), &p).expect("copy");
+    p
+}
+
+/// The Transforms in file order, with their first op's translation.
+fn transforms(app: &TracelabApp) -> Vec<(NodeId, Vec3)> {
+    app.doc
+        .scene
+        .graph
+        .iter()
+        .filter_map(|(id, n)| match &n.kind {
+            NodeKind::Transform(ops) => match ops.first() {
+                Some(TransformOp::Translate(t)) => Some((id, *t)),
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect()
+}
+
+fn translate_x(app: &TracelabApp, id: NodeId) -> f32 {
+    match &app.doc.scene.graph.node(id).kind {
+        NodeKind::Transform(ops) => match ops[0] {
+            TransformOp::Translate(t) => t.x,
+            _ => panic!("not a Translate"),
+        },
+        _ => panic!("not a Transform"),
+    }
+}
+
+/// Dirty, with something to undo and to redo, the red sphere's Transform selected: every
+/// shortcut of the table has something to act on.
+fn prepared(tag: &str) -> Harness<'static, TracelabApp> {
+    let mut h = harness(sheared(tag));
+    let (id, t) = transforms(h.state())[1];
+    for x in [2.0, 3.0] {
+        h.state_mut().apply(Edit::SetTransformOp {
+            node: id,
+            index: 0,
+            op: TransformOp::Translate(Vec3::new(x, t.y, t.z)),
+        });
+        h.state_mut().doc.end_gesture();
+    }
+    h.state_mut().doc.undo();
+    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.step();
+    h.step();
+    assert!(h.state().doc.can_undo() && h.state().doc.can_redo() && h.state().doc.is_dirty());
+    h
+}
+
+/// What a shortcut may change: the document, the selection, the dialogs.
+fn fingerprint(app: &TracelabApp) -> String {
+    format!(
+        "{} {} {} {:?} {:?} {:?} {:?}",
+        app.doc.generation,
+        app.doc.is_dirty(),
+        app.doc.can_undo(),
+        app.doc.selection,
+        app.dialog.as_ref().map(|d| d.purpose),
+        app.confirm,
+        app.dialog_up(),
+    )
+}
+
+fn press(h: &mut Harness<'static, TracelabApp>, k: &KeyboardShortcut) {
+    h.key_press_modifiers(k.modifiers, k.logical_key);
+    for _ in 0..3 {
+        h.step();
+    }
+}
+
+fn every_shortcut() -> Vec<(&'static str, KeyboardShortcut)> {
+    menu::ENTRIES
+        .iter()
+        .flat_map(|e| e.keys.iter().map(move |k| (e.label, *k)))
+        .collect()
+}
+
+#[test]
+fn every_shortcut_acts_on_the_scene_when_no_dialog_is_up() {
+    // The positive control of the two tests below.
+    for (label, k) in every_shortcut() {
+        let mut h = prepared("control");
+        let before = fingerprint(h.state());
+        press(&mut h, &k);
+        assert_ne!(
+            fingerprint(h.state()),
+            before,
+            "{label}: the key did nothing"
+        );
+    }
+}
+
+fn nothing_reaches_the_scene_behind(dialog: Dialog, open: fn(&mut Harness<'static, TracelabApp>)) {
+    let mut h = prepared("behind");
+    open(&mut h);
+    assert_eq!(h.state().dialog_up(), Some(dialog));
+    let before = fingerprint(h.state());
+    for (label, k) in every_shortcut() {
+        press(&mut h, &k);
+        assert_eq!(
+            fingerprint(h.state()),
+            before,
+            "{label} ({k:?}) acted behind the {dialog:?} dialog"
+        );
+    }
+}
+
+#[test]
+fn no_shortcut_reaches_the_scene_behind_the_open_dialog() {
+    nothing_reaches_the_scene_behind(Dialog::File, |h| {
+        press(h, &KeyboardShortcut::new(Modifiers::COMMAND, egui::Key::O));
+    });
+}
+
+#[test]
+fn no_shortcut_reaches_the_scene_behind_the_unsaved_changes_question() {
+    nothing_reaches_the_scene_behind(Dialog::Confirm, |h| {
+        press(h, &KeyboardShortcut::new(Modifiers::COMMAND, egui::Key::N));
+        assert_eq!(h.state().confirm, Some(Pending::New));
+    });
+}
+
+/// Selects the first Transform (Translate -1.2 0 0) of a fresh copy.
+fn first_transform(tag: &str) -> (Harness<'static, TracelabApp>, NodeId) {
+    let mut h = harness(sheared(tag));
+    let (id, t) = transforms(h.state())[0];
+    assert_eq!(t.x, -1.2);
+    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.step();
+    h.step();
+    (h, id)
+}
+
+/// Focus turns a drag value into a text field; typing replaces the selected old text.
+fn focus_and_type(h: &mut Harness<'static, TracelabApp>, label: &str, text: &str) {
+    let role = egui::accesskit::Role::SpinButton;
+    h.get_by_role_and_label(role, label).focus();
+    h.step();
+    h.step();
+    h.get_by_role_and_label(role, label).type_text(text);
+    h.step();
+    h.step();
+}
+
+#[test]
+fn a_typed_number_is_applied_on_enter_as_one_undo_step() {
+    let (mut h, id) = first_transform("typed");
+    let generation = h.state().doc.generation;
+    focus_and_type(&mut h, "Translate x", "-2.75");
+    // While typing nothing is applied: no half-typed value is an undo step.
+    assert_eq!(translate_x(h.state(), id), -1.2);
+    assert_eq!(h.state().doc.generation, generation);
+    h.key_press(egui::Key::Enter);
+    h.step();
+    h.step();
+    assert_eq!(translate_x(h.state(), id), -2.75, "Enter applies");
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    h.step();
+    assert_eq!(
+        translate_x(h.state(), id),
+        -1.2,
+        "one Ctrl+Z undoes the typed value"
+    );
+    assert!(
+        !h.state().doc.can_undo(),
+        "no steps left for half-typed values"
+    );
+}
+
+#[test]
+fn a_typed_number_is_applied_when_the_field_loses_focus() {
+    let (mut h, id) = first_transform("focus-loss");
+    focus_and_type(&mut h, "Translate x", "0.5");
+    h.get_by_role_and_label(egui::accesskit::Role::SpinButton, "Translate y")
+        .focus();
+    h.step();
+    h.step();
+    assert_eq!(translate_x(h.state(), id), 0.5);
+}
+
+#[test]
+fn esc_in_a_number_field_restores_the_value_from_before() {
+    let (mut h, id) = first_transform("esc");
+    focus_and_type(&mut h, "Translate x", "9");
+    h.key_press(egui::Key::Escape);
+    for _ in 0..3 {
+        h.step();
+    }
+    assert_eq!(translate_x(h.state(), id), -1.2);
+    assert!(!h.state().doc.can_undo());
+    assert!(!h.state().doc.is_dirty());
+}
+
+/// Where the things a user clicks next are: the inspector's heading, the tree's first row
+/// and the picture.
+fn layout(h: &Harness<'static, TracelabApp>) -> Vec<egui::Rect> {
+    let mut out = vec![
+        h.get_by_label("Inspector").rect(),
+        h.get_by_label_contains("Camera").rect(),
+    ];
+    out.extend(h.state().shown().iter().map(|s| s.rect));
+    out
+}
+
+#[test]
+fn notices_are_typed_counted_once_and_never_move_the_layout() {
+    use tracelab::document::notice::Level;
+    let mut h = harness(sheared("notices"));
+    h.state_mut().doc.select(None);
+    h.step();
+    let before = layout(&h);
+    assert!(!before.is_empty());
+    let f = KeyboardShortcut::new(Modifiers::NONE, egui::Key::F);
+    press(&mut h, &f);
+    // Shown (the positive control: something did appear)…
+    let _ = h.get_by_label_contains("Frame selected: select an object first");
+    // …over the view, so nothing the user was about to click has moved.
+    assert_eq!(layout(&h), before, "a notice moved the layout");
+    press(&mut h, &f);
+    press(&mut h, &f);
+    let notices: Vec<_> = h.state().doc.messages.iter().cloned().collect();
+    assert_eq!(notices.len(), 1, "{notices:?}");
+    assert_eq!((notices[0].level, notices[0].count), (Level::Warning, 3));
+    let _ = h.get_by_label_contains("(×3)");
+    assert_eq!(layout(&h), before);
+
+    // Success is info, not an error.
+    let out = common::temp_dir("manners", "export").join("view.png");
+    h.state_mut()
+        .queue(tracelab::gui::command::AppCommand::Export(out.clone()));
+    h.step();
+    h.step();
+    let last = h
+        .state()
+        .doc
+        .messages
+        .iter()
+        .last()
+        .cloned()
+        .expect("a notice");
+    assert_eq!(last.level, Level::Info, "{last:?}");
+    assert!(last.text.starts_with("exported"), "{last:?}");
+    assert!(out.is_file());
+    assert_eq!(layout(&h), before);
+
+    // Dismiss all clears them; the layout still has not moved.
+    h.get_by_label("Dismiss all").click();
+    h.step();
+    h.step();
+    assert!(h.state().doc.messages.is_empty());
+    assert_eq!(layout(&h), before);
+}
