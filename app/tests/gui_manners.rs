@@ -293,3 +293,41 @@ fn notices_are_typed_counted_once_and_never_move_the_layout() {
     assert!(h.state().doc.messages.is_empty());
     assert_eq!(layout(&h), before);
 }
+
+/// Bug 2: the first click opens the dock and the view shrinks; the story must still be that
+/// of the pixel that was under the pointer, not of the same fraction of a smaller image.
+#[test]
+fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .with_max_steps(10_000)
+        .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
+    settle(&mut h);
+    assert!(!h.state().pixel_inspector_open);
+    let (w, rows) = {
+        let s = &h.state().shown()[0];
+        (s.image.size[0] as u32, s.image.size[1] as u32)
+    };
+    // High in the image, where scaling the row would land far from it.
+    let (x, row) = (w / 2, rows / 6);
+    h.state_mut().inspect(0, x, row);
+    let (picked, _) = h.state().story.clone().expect("a story");
+    settle(&mut h);
+    let new_rows = h.state().shown()[0].image.size[1] as u32;
+    // The positive control: the dock did shrink the view (else this test proves nothing).
+    assert!(new_rows + 50 < rows, "{rows} → {new_rows}");
+    let (now, _) = h.state().story.clone().expect("a story");
+    let pixel_size = 5.0 / w.max(rows) as f32 * 1.5; // the built-in camera spans about 5 units
+    let moved = (now.world_ray.origin - picked.world_ray.origin).length()
+        + (now.world_ray.direction - picked.world_ray.direction).length() * 10.0;
+    assert!(
+        moved < pixel_size.max(0.02),
+        "the story moved from {:?} to {:?}",
+        picked.world_ray,
+        now.world_ray
+    );
+    assert_eq!(
+        now.hit.as_ref().map(|h| h.node),
+        picked.hit.as_ref().map(|h| h.node)
+    );
+}

@@ -668,7 +668,9 @@ impl TracelabApp {
     /// Traces the inspected pixel again when a newer render is published, so the story is
     /// always that of the image on screen. The selection stays as the user left it.
     fn follow_inspected(&mut self) {
-        let Some(at) = self.inspected else { return };
+        let Some(at) = self.inspected.clone() else {
+            return;
+        };
         if let Some((at, story, scene)) = self
             .worker
             .with_published(|p| pixel_inspector::follow(p?, &at))
