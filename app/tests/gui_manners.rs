@@ -312,10 +312,15 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
     let (x, row) = (w / 2, rows / 6);
     h.state_mut().inspect(0, x, row);
     let (picked, _) = h.state().story.clone().expect("a story");
+    let before = h.state().shown()[0].rect;
     settle(&mut h);
-    let new_rows = h.state().shown()[0].image.size[1] as u32;
-    // The positive control: the dock did shrink the view (else this test proves nothing).
-    assert!(new_rows + 50 < rows, "{rows} → {new_rows}");
+    assert!(h.state().pixel_inspector_open);
+    let after = h.state().shown()[0].rect;
+    // The dock took the bottom of the view (the positive control)…
+    assert!(after.height() + 50.0 < before.height(), "{before:?} → {after:?}");
+    // …and the picture kept its size and place: only its bottom is hidden.
+    assert_eq!(after.min, before.min);
+    assert_eq!(h.state().shown()[0].image.size[1] as u32, rows);
     let (now, _) = h.state().story.clone().expect("a story");
     let pixel_size = 5.0 / w.max(rows) as f32 * 1.5; // the built-in camera spans about 5 units
     let moved = (now.world_ray.origin - picked.world_ray.origin).length()

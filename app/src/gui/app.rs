@@ -1128,6 +1128,10 @@ impl TracelabApp {
             });
         });
         self.layout.shown_inspector(inspector.response.rect.width());
+        // The height the dock takes from the view: the picture keeps the size and place it
+        // had without the dock (its bottom hidden behind it), so opening the dock by a click
+        // never moves or rescales what is under the pointer.
+        let bottom = ui.available_rect_before_wrap().bottom();
         if self.pixel_inspector_open {
             // Docked under the view, between the side panels: it covers neither the tree nor
             // the image, and the next click in the view is free.
@@ -1165,6 +1169,7 @@ impl TracelabApp {
                     });
             });
         }
+        let reserve = (bottom - ui.available_rect_before_wrap().bottom()).max(0.0);
         let mut pick = None;
         let mut size = (1, 1);
         let view = egui::CentralPanel::default().show(ui, |ui| {
@@ -1188,12 +1193,18 @@ impl TracelabApp {
                 });
             }
             ui.separator();
-            size = Viewport::render_size(&self.view, ui.available_size(), ui.pixels_per_point());
+            let area = ui.available_size() + egui::vec2(0.0, reserve);
+            size = Viewport::render_size(&self.view, area, ui.pixels_per_point());
             self.render_size = size;
             self.request_render(size);
-            pick = self
-                .viewport
-                .images(ui, &mut self.view, &self.worker, &self.doc, &mut asked);
+            pick = self.viewport.images(
+                ui,
+                &mut self.view,
+                &self.worker,
+                &self.doc,
+                &mut asked,
+                reserve,
+            );
         });
         notifications::ui(&ctx, &mut self.doc.messages, view.response.rect);
         self.commands.extend(asked);

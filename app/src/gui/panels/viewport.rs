@@ -134,6 +134,22 @@ pub struct Drawn {
     pub uv: egui::Rect,
 }
 
+impl Drawn {
+    /// The part of `rect` (showing `uv` of the texture) inside `clip`, with its own uv.
+    fn clipped(texture: usize, rect: egui::Rect, uv: egui::Rect, clip: egui::Rect) -> Self {
+        let shown = rect.intersect(clip);
+        let at = |p: egui::Pos2| {
+            let t = (p - rect.min) / rect.size();
+            uv.min + t * uv.size()
+        };
+        Drawn {
+            texture,
+            rect: shown,
+            uv: egui::Rect::from_min_max(at(shown.min), at(shown.max)),
+        }
+    }
+}
+
 /// Pixels the view put on screen: what the texture held when it was drawn.
 #[derive(Clone, Debug)]
 pub struct Shown {
@@ -304,7 +320,9 @@ impl Viewport {
     }
 
     /// Draws the images with the gizmo and overlays, queues what the mouse tools ask for,
-    /// and returns a pick when the user clicked a pixel.
+    /// and returns a pick when the user clicked a pixel. `hidden_below`: the height a panel
+    /// under the view (the dock) takes from it; the images are laid out as if it were not
+    /// there and clipped, so that panel never moves or rescales them.
     pub fn images(
         &mut self,
         ui: &mut egui::Ui,
@@ -312,6 +330,7 @@ impl Viewport {
         worker: &RenderWorker,
         doc: &Document,
         out: &mut Vec<AppCommand>,
+        hidden_below: f32,
     ) -> Option<Pick> {
         let cells = s.cells();
         let ctx = ui.ctx().clone();
@@ -343,6 +362,8 @@ impl Viewport {
                     egui::Sense::click_and_drag(),
                 );
                 let mut img_area = cell;
+                img_area.max.y += hidden_below;
+                let painter = ui.painter().with_clip_rect(cell.intersect(ui.clip_rect()));
                 if !caption.is_empty() {
                     ui.painter().text(
                         cell.left_top() + egui::vec2(4.0, 2.0),
@@ -381,23 +402,14 @@ impl Viewport {
                         egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(s.split, 1.0));
                     let ruv =
                         egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
-                    ui.painter()
-                        .image(tex.id(), left, luv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn {
-                        texture: tex_i,
-                        rect: left,
-                        uv: luv,
-                    });
+                    painter.image(tex.id(), left, luv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn::clipped(tex_i, left, luv, cell));
                     if let Some(o) = other {
-                        ui.painter().image(o.id(), right, ruv, egui::Color32::WHITE);
+                        painter.image(o.id(), right, ruv, egui::Color32::WHITE);
                         let texture = self.tex_index(1, view);
-                        self.drawn.push(Drawn {
-                            texture,
-                            rect: right,
-                            uv: ruv,
-                        });
+                        self.drawn.push(Drawn::clipped(texture, right, ruv, cell));
                     }
-                    ui.painter().vline(
+                    painter.vline(
                         xs,
                         rect.y_range(),
                         egui::Stroke::new(2.0, egui::Color32::YELLOW),
@@ -408,12 +420,8 @@ impl Viewport {
                         s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
                     }
                 } else {
-                    ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn {
-                        texture: tex_i,
-                        rect,
-                        uv,
-                    });
+                    painter.image(tex.id(), rect, uv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn::clipped(tex_i, rect, uv, cell));
                 }
                 let view = OnScreen::new(&doc.scene.camera, w as u32, h as u32, rect);
                 let surface = |px: glam::Vec2| surface_point(worker, frame, px);
@@ -421,7 +429,7 @@ impl Viewport {
                     .tools
                     .cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
                 if s.overlays {
-                    let painter = ui.painter().with_clip_rect(rect);
+                    let painter = painter.with_clip_rect(rect.intersect(painter.clip_rect()));
                     if let Some(o) = &self.outline {
                         painter.image(o.id(), rect, uv, egui::Color32::WHITE);
                     }
@@ -438,15 +446,17 @@ impl Viewport {
                             (my as f32 + 0.5) / h as f32 * rect.height(),
                         );
                     let stroke = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 0, 255));
-                    ui.painter().circle_stroke(c, 6.0, stroke);
-                    ui.painter().hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
-                    ui.painter().hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
-                    ui.painter().vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
-                    ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
+                    painter.circle_stroke(c, 6.0, stroke);
+                    painter.hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
+                    painter.hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
+                    painter.vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
+                    painter.vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
                 }
                 if resp.clicked()
                     && !used
-                    && let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p))
+                    && let Some(pos) = resp
+                        .interact_pointer_pos()
+                        .filter(|p| rect.contains(*p) && cell.contains(*p))
                 {
                     let u = (pos.x - rect.left()) / rect.width();
                     let v = (pos.y - rect.top()) / rect.height();
