@@ -307,7 +307,9 @@ fn recent_files_and_view_settings_persist() {
     eframe::App::save(&mut a, &mut m);
     let mut b = TracelabApp::new(None, AppOptions::default());
     b.load_persisted(&m);
-    assert_eq!(b.recent, vec![repo("scenes/hierarchy.txt")]);
+    // Kept canonical, so the entry works from any folder (issue 26 bug 5).
+    let canonical = std::fs::canonicalize(repo("scenes/hierarchy.txt")).expect("canonical");
+    assert_eq!(b.recent, vec![canonical]);
     assert_eq!(b.view.tab, tracelab::gui::panels::viewport::Tab::Depth);
     assert_eq!(b.view.depth, (3.0, 12.5));
 }
@@ -416,7 +418,8 @@ fn a_scene_dropped_on_the_window_opens() {
     step_until(&mut h, 10, "the dropped scene", |a| {
         a.doc.path.as_deref() == Some(path.as_path())
     });
-    assert_eq!(h.state().recent.first(), Some(&path));
+    let canonical = std::fs::canonicalize(&path).expect("canonical");
+    assert_eq!(h.state().recent.first(), Some(&canonical));
 }
 
 #[test]

@@ -317,7 +317,10 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
     assert!(h.state().pixel_inspector_open);
     let after = h.state().shown()[0].rect;
     // The dock took the bottom of the view (the positive control)…
-    assert!(after.height() + 50.0 < before.height(), "{before:?} → {after:?}");
+    assert!(
+        after.height() + 50.0 < before.height(),
+        "{before:?} → {after:?}"
+    );
     // …and the picture kept its size and place: only its bottom is hidden.
     assert_eq!(after.min, before.min);
     assert_eq!(h.state().shown()[0].image.size[1] as u32, rows);
@@ -335,4 +338,70 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
         now.hit.as_ref().map(|h| h.node),
         picked.hit.as_ref().map(|h| h.node)
     );
+}
+
+/// Bug 5: a file opened by a relative name is remembered by its canonical path.
+#[test]
+fn open_recent_keeps_canonical_paths() {
+    let dir = common::temp_dir("manners", "recent");
+    let sub = dir.join("sub");
+    std::fs::create_dir_all(&sub).expect("mkdir");
+    let file = sub.join("s.txt");
+    std::fs::copy(common::repo().join("scenes/flat_transforms.txt"), &file).expect("copy");
+    let mut app = TracelabApp::new(None, AppOptions::default());
+    // Named through "..", as a relative path from the working folder would be.
+    assert!(app.open_now(&sub.join("..").join("sub").join("s.txt")));
+    let want = std::fs::canonicalize(&file).expect("canonical");
+    assert_eq!(app.recent, vec![want.clone()]);
+    assert!(want.is_absolute());
+    // The same file by another name is one entry.
+    assert!(app.open_now(&file));
+    assert_eq!(app.recent, vec![want]);
+}
+
+/// Bug 4: double-clicking a folder in the built-in Open dialog enters it and opens nothing
+/// (its second click lands on the folder's first scene).
+#[test]
+fn double_clicking_a_folder_in_the_open_dialog_enters_it_and_opens_nothing() {
+    use tracelab::gui::file_dialog::{FileDialog, Purpose};
+    let dir = common::temp_dir("manners", "dialog");
+    let sub = dir.join("a_folder");
+    std::fs::create_dir_all(&sub).expect("mkdir");
+    // The scene sits where the folder's row was: the second click lands on it.
+    std::fs::copy(
+        common::repo().join("scenes/flat_transforms.txt"),
+        sub.join("a_scene.txt"),
+    )
+    .expect("copy");
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
+    settle(&mut h);
+    h.state_mut().dialog = Some(FileDialog::new(Purpose::Open, Some(&dir.join("x.txt"))));
+    h.step();
+    h.step();
+    // The harness steps a quarter second a frame: allow for that between the two clicks.
+    h.ctx
+        .options_mut(|o| o.input_options.max_double_click_delay = 2.0);
+    let at = h.get_by_label("a_folder/").rect().center();
+    for _ in 0..2 {
+        for pressed in [true, false] {
+            h.event(egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: Modifiers::NONE,
+            });
+        }
+        h.step();
+    }
+    for _ in 0..3 {
+        h.step();
+    }
+    // The positive control: the folder was entered (its scene is listed).
+    let _ = h.get_by_label("a_scene.txt");
+    assert!(h.state().dialog.is_some(), "the dialog closed");
+    assert_eq!(h.state().doc.path, None, "a scene was opened");
+    assert!(!h.state().is_loading(), "a scene is being opened");
 }

@@ -481,10 +481,19 @@ impl TracelabApp {
                 .messages
                 .info(format!("{}: reloaded (changed on disk)", path.display()));
         }
+        self.remember(&path);
+        true
+    }
+
+    /// Puts `path` first in Open recent, as a canonical path: an entry works from any folder
+    /// tracelab is started in, and one file is one entry however it was named.
+    fn remember(&mut self, path: &Path) {
+        let path = std::fs::canonicalize(path)
+            .or_else(|_| std::path::absolute(path))
+            .unwrap_or_else(|_| path.to_path_buf());
         self.recent.retain(|r| r != &path);
         self.recent.insert(0, path);
         self.recent.truncate(MAX_RECENT);
-        true
     }
 
     /// Re-reads the file from disk (in the background), keeping the selection when it
@@ -561,9 +570,7 @@ impl TracelabApp {
     fn write(&mut self, path: &Path) -> bool {
         match self.doc.save_as(path) {
             Ok(()) => {
-                self.recent.retain(|r| r != path);
-                self.recent.insert(0, path.to_path_buf());
-                self.recent.truncate(MAX_RECENT);
+                self.remember(path);
                 true
             }
             Err(e) => {
