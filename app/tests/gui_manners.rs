@@ -405,3 +405,41 @@ fn double_clicking_a_folder_in_the_open_dialog_enters_it_and_opens_nothing() {
     assert_eq!(h.state().doc.path, None, "a scene was opened");
     assert!(!h.state().is_loading(), "a scene is being opened");
 }
+
+/// Bug 6: a Lecture figure asked for over unsaved changes, then Cancel: nothing of it is
+/// applied (caption, split compare). Discard (the positive control) applies it all.
+#[test]
+fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
+    use tracelab::gui::command::AppCommand;
+    use tracelab::gui::lecture::FIGURES;
+    use tracelab::gui::panels::viewport::Compare;
+    let i = FIGURES
+        .iter()
+        .position(|f| f.compare == Compare::Split)
+        .expect("a split figure");
+    for (answer, applied) in [("Cancel", false), ("Discard changes", true)] {
+        let mut h = prepared("lecture");
+        let view = format!("{:?}", h.state().view);
+        let scene = h.state().doc.scene.clone();
+        h.state_mut().queue(AppCommand::OpenLecture(i));
+        let start = std::time::Instant::now();
+        while h.state().confirm.is_none() {
+            h.step();
+            assert!(start.elapsed().as_secs() < 30, "never asked");
+        }
+        h.step();
+        h.step();
+        h.get_by_label(answer).click();
+        for _ in 0..3 {
+            h.step();
+        }
+        settle(&mut h);
+        let app = h.state();
+        assert_eq!(app.lecture.is_some(), applied, "{answer}");
+        assert_eq!(app.view.compare == Compare::Split, applied, "{answer}");
+        if !applied {
+            assert_eq!(format!("{:?}", app.view), view);
+            assert_eq!(app.doc.scene, scene);
+        }
+    }
+}

@@ -81,6 +81,9 @@ pub struct TracelabApp {
     pub animation_running: Option<animation_dialog::Running>,
     /// The Lecture menu's figure on show, for its caption.
     pub lecture: Option<usize>,
+    /// A figure whose scene is being read (or waits for the unsaved-changes answer): its view
+    /// and caption are applied when that scene is installed, and dropped if it is not.
+    pending_lecture: Option<usize>,
     /// How each Ray diagram (world, object) is turned.
     pub ray_orbits: [Orbit; 2],
     pub dialog: Option<FileDialog>,
@@ -132,6 +135,7 @@ impl TracelabApp {
             ray_panel_open: true,
             ray_orbits: [Orbit::default(); 2],
             lecture: None,
+            pending_lecture: None,
             animation: None,
             animation_running: None,
             dialog: None,
@@ -252,18 +256,21 @@ impl TracelabApp {
             AppCommand::Inspect { frame, x, row } => self.inspect(frame, x, row),
             AppCommand::New => {
                 self.lecture = None;
+                self.pending_lecture = None;
                 self.new_document();
             }
             AppCommand::OpenDialog => self.show_file_dialog(Purpose::Open),
             AppCommand::Open(p) => {
                 self.lecture = None;
+                self.pending_lecture = None;
                 self.open(&p);
             }
             AppCommand::OpenLecture(i) => {
                 if let Some(f) = lecture::FIGURES.get(i) {
-                    f.apply(&mut self.view);
+                    // Its view and caption come with its scene, once installed: a Cancel
+                    // over unsaved changes leaves everything as it was.
                     self.open(&f.path());
-                    self.lecture = Some(i);
+                    self.pending_lecture = Some(i);
                 }
             }
             AppCommand::CloseCaption => self.lecture = None,
@@ -464,6 +471,10 @@ impl TracelabApp {
     fn install(&mut self, read: SceneRead, reload: bool) -> bool {
         let path = read.path.clone();
         let selection = self.doc.selection;
+        let figure = self
+            .pending_lecture
+            .take()
+            .filter(|&i| !reload && lecture::FIGURES.get(i).is_some_and(|f| f.path() == path));
         if self.doc.install(read).is_err() {
             if reload {
                 // Not again until the file changes again.
@@ -475,6 +486,10 @@ impl TracelabApp {
         self.inspected = None;
         self.viewport.marker = None;
         self.disk_changed = false;
+        if let Some(i) = figure {
+            lecture::FIGURES[i].apply(&mut self.view);
+            self.lecture = Some(i);
+        }
         if reload {
             self.doc.select(selection);
             self.doc
@@ -988,6 +1003,7 @@ impl TracelabApp {
                     Some(_) => {
                         self.confirm = None;
                         self.ready = None;
+                        self.pending_lecture = None;
                     }
                     None => {}
                 }
