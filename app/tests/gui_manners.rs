@@ -443,3 +443,29 @@ fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
         }
     }
 }
+
+/// Bug 9: at the smallest window the panels keep their widths and the view its 320 points;
+/// grown to 1280, the tree is as wide as before (nothing squeezed to remember).
+#[test]
+fn at_the_smallest_window_every_panel_keeps_its_width_and_growing_keeps_it() {
+    use tracelab::gui::layout::{MIN_VIEW_WIDTH, MIN_WINDOW, TREE_WIDTH};
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(MIN_WINDOW[0], MIN_WINDOW[1]))
+        .with_max_steps(10_000)
+        .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
+    settle(&mut h);
+    let view = h.state().shown()[0].rect;
+    assert!(view.width() >= MIN_VIEW_WIDTH - 1.0, "{view:?}");
+    let tree_edge = |h: &Harness<'static, TracelabApp>| {
+        h.query_all_by_role(egui::accesskit::Role::Splitter)
+            .map(|n| n.rect().center().x)
+            .min_by(f32::total_cmp)
+            .expect("a resize handle")
+    };
+    let small = tree_edge(&h);
+    // The positive control: the tree is at its first width, not at egui's minimum.
+    assert!(small >= TREE_WIDTH - 2.0, "tree edge at {small}");
+    h.set_size(egui::vec2(1280.0, 800.0));
+    settle(&mut h);
+    assert!((tree_edge(&h) - small).abs() < 1.0);
+}

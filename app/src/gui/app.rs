@@ -1270,6 +1270,7 @@ pub fn run(scene: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 800.0])
+            .with_min_inner_size(crate::gui::layout::MIN_WINDOW)
             .with_title("tracelab")
             .with_drag_and_drop(true),
         ..Default::default()
