@@ -469,3 +469,24 @@ fn at_the_smallest_window_every_panel_keeps_its_width_and_growing_keeps_it() {
     settle(&mut h);
     assert!((tree_edge(&h) - small).abs() < 1.0);
 }
+
+/// 28 item 3: a render thread the system refused is said in the view, not "Rendering…"
+/// forever. The positive control: a working worker shows no such line.
+#[test]
+fn a_render_thread_that_could_not_start_is_shown() {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
+    settle(&mut h);
+    assert!(
+        h.query_by_label_contains("cannot start the renderer")
+            .is_none()
+    );
+    h.state_mut().worker =
+        tracelab::render_worker::RenderWorker::failed_to_start("Resource temporarily unavailable");
+    for _ in 0..3 {
+        h.step();
+    }
+    let _ = h.get_by_label_contains("cannot start the renderer: Resource temporarily unavailable");
+}

@@ -339,7 +339,13 @@ impl Viewport {
         self.tools.begin_frame();
         worker.with_published(|p| {
             let Some(p) = p else {
-                ui.label("Rendering…");
+                match worker.spawn_error() {
+                    Some(e) => ui.colored_label(
+                        ui.visuals().error_fg_color,
+                        format!("cannot start the renderer: {e}"),
+                    ),
+                    None => ui.label("Rendering…"),
+                };
                 return;
             };
             self.upload(&ctx, p, s);
