@@ -521,6 +521,8 @@ fn adding_a_triangle_mesh_and_loading_its_obj() {
     h.step();
     h.get_by_label("Load / reload").click();
     h.step();
+    // Read on a thread (the window keeps painting): wait for it.
+    step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
     let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc.scene.graph.node(id).kind else {
         panic!("a TriangleMesh")
     };
@@ -797,7 +799,7 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     );
     h.get_by_label("Load / reload").click();
     h.step();
-    h.step();
+    step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
     let file = |app: &TracelabApp| match &app.doc.scene.graph.node(id).kind {
         NodeKind::TriangleMesh { obj_file, .. } => obj_file.clone(),
         _ => String::new(),

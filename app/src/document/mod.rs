@@ -28,6 +28,21 @@ pub enum Selection {
     Node(NodeId),
 }
 
+/// Reads `obj_file` (relative to `base`) into `cache` afresh: the file may have changed. Any
+/// thread; the error is kept on the node.
+pub fn read_mesh(obj_file: &str, base: Option<&Path>, cache: &mut MeshCache) -> MeshSlot {
+    match tracelab_core::format::obj::resolve_obj_path(obj_file, base) {
+        Ok(p) => {
+            cache.forget(&p);
+            match cache.load(&p) {
+                Ok(m) => MeshSlot::Loaded(m),
+                Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
+            }
+        }
+        Err(e) => MeshSlot::Failed(e.to_string()),
+    }
+}
+
 /// One state in the history: the scene and the id of that state (for the dirty flag).
 struct Snapshot {
     scene: Scene,
@@ -250,19 +265,21 @@ impl Document {
     /// Sets a TriangleMesh's `obj_file` and (re)reads that file from disk, as one edit: the
     /// mesh is read again even when the name is unchanged (the file may have changed), and
     /// a file that does not load leaves the node with the error. Relative names resolve from
-    /// the document's folder.
+    /// the document's folder. Blocking; the window reads on a thread with [`read_mesh`] and
+    /// [`Self::set_mesh`].
     pub fn load_mesh(&mut self, node: NodeId, obj_file: String) -> Result<(), Refusal> {
         let base = self.path.as_deref().and_then(Path::parent);
-        let mesh = match tracelab_core::format::obj::resolve_obj_path(&obj_file, base) {
-            Ok(p) => {
-                self.mesh_cache.forget(&p);
-                match self.mesh_cache.load(&p) {
-                    Ok(m) => MeshSlot::Loaded(m),
-                    Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
-                }
-            }
-            Err(e) => MeshSlot::Failed(e.to_string()),
-        };
+        let mesh = read_mesh(&obj_file, base, &mut self.mesh_cache);
+        self.set_mesh(node, obj_file, mesh)
+    }
+
+    /// A TriangleMesh's file and the mesh read from it (or why not), as one edit.
+    pub fn set_mesh(
+        &mut self,
+        node: NodeId,
+        obj_file: String,
+        mesh: MeshSlot,
+    ) -> Result<(), Refusal> {
         self.apply(Edit::SetNodeKind {
             node,
             kind: NodeKind::TriangleMesh { obj_file, mesh },

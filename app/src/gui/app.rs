@@ -20,6 +20,7 @@ use crate::gui::layout::Layout;
 use crate::gui::lecture;
 use crate::gui::loading::{LoadPurpose, Loading};
 use crate::gui::menu;
+use crate::gui::mesh_load::MeshLoad;
 use crate::gui::native_dialog::{Answer, NativeDialog};
 use crate::gui::notifications;
 use crate::gui::panels::pixel_inspector::Inspected;
@@ -94,6 +95,9 @@ pub struct TracelabApp {
     ready: Option<SceneRead>,
     /// The file being read in the background, if any.
     loading: Option<Loading>,
+    /// TriangleMesh files being read in the background, for the document open now (dropped
+    /// when another is installed: their node ids belong to this one).
+    mesh_loads: Vec<MeshLoad>,
     repaint: Arc<dyn Fn() + Send + Sync>,
     layout: Layout,
     /// Bumped whenever the document changes other than by the panels' own edits (open,
@@ -144,6 +148,7 @@ impl TracelabApp {
             confirm: None,
             ready: None,
             loading: None,
+            mesh_loads: Vec::new(),
             repaint: Arc::new(|| {}),
             layout: Layout::default(),
             widget_epoch: 0,
@@ -244,9 +249,14 @@ impl TracelabApp {
             AppCommand::Edit(Edit::SetOpOfKind { node, op }) => self.gizmo_edit(node, op),
             AppCommand::Edit(e) => self.apply(e),
             AppCommand::LoadMesh { node, obj_file } => {
-                if let Err(e) = self.doc.load_mesh(node, obj_file) {
-                    self.doc.messages.error(format!("edit refused: {e}"));
-                }
+                let base = self.doc.path.as_deref().and_then(Path::parent);
+                self.mesh_loads.push(MeshLoad::start(
+                    node,
+                    obj_file,
+                    base.map(Path::to_path_buf),
+                    self.doc.mesh_cache.clone(),
+                    self.repaint.clone(),
+                ));
             }
             AppCommand::DeleteSelected => {
                 if let Some(Selection::Node(node)) = self.doc.selection {
@@ -418,9 +428,27 @@ impl TracelabApp {
         self.install(read, false)
     }
 
-    /// Whether a file is being read in the background.
+    /// Whether a file (a scene or a mesh) is being read in the background.
     pub fn is_loading(&self) -> bool {
-        self.loading.is_some()
+        self.loading.is_some() || !self.mesh_loads.is_empty()
+    }
+
+    /// Applies the meshes read since the last frame, each as one edit.
+    fn poll_mesh_loads(&mut self) {
+        let mut i = 0;
+        while i < self.mesh_loads.len() {
+            let Some(r) = self.mesh_loads[i].poll() else {
+                i += 1;
+                continue;
+            };
+            self.mesh_loads.remove(i);
+            if matches!(r.mesh, tracelab_core::MeshSlot::Loaded(_)) {
+                self.doc.mesh_cache = r.cache;
+            }
+            if let Err(e) = self.doc.set_mesh(r.node, r.obj_file, r.mesh) {
+                self.doc.messages.error(format!("edit refused: {e}"));
+            }
+        }
     }
 
     fn start_loading(&mut self, path: &Path, purpose: LoadPurpose) {
@@ -486,6 +514,7 @@ impl TracelabApp {
         self.inspected = None;
         self.viewport.marker = None;
         self.disk_changed = false;
+        self.mesh_loads.clear();
         if let Some(i) = figure {
             lecture::FIGURES[i].apply(&mut self.view);
             self.lecture = Some(i);
@@ -536,6 +565,7 @@ impl TracelabApp {
         self.doc = Document::builtin();
         self.doc.mesh_cache = cache;
         self.doc.generation = generation;
+        self.mesh_loads.clear();
         self.story = None;
         self.inspected = None;
         self.viewport.marker = None;
@@ -1056,6 +1086,7 @@ impl TracelabApp {
         let keys = menu::shortcuts(&ctx, self.dialog_up());
         self.commands.extend(keys);
         self.poll_loading();
+        self.poll_mesh_loads();
         self.watch_disk();
         // Files dropped onto the window.
         let dropped: Vec<PathBuf> = ctx.input(|i| {
@@ -1246,7 +1277,7 @@ impl TracelabApp {
         if self.viewport.tools.dragging() || self.viewport.tools.wheel_busy() {
             // Notice when the pointer stops, to refine.
             ctx.request_repaint_after(view_tools::STILL_AFTER / 2);
-        } else if !self.worker.is_idle() || self.loading.is_some() {
+        } else if !self.worker.is_idle() || self.is_loading() {
             ctx.request_repaint_after(Duration::from_millis(30));
         } else if !self.file_watch.has_events() {
             // No file events here: look at the file on disk now and then while idle.

@@ -12,6 +12,7 @@ pub mod layout;
 pub mod lecture;
 pub mod loading;
 pub mod menu;
+pub mod mesh_load;
 pub mod native_dialog;
 pub mod notifications;
 pub mod on_screen;
