@@ -490,3 +490,22 @@ fn a_render_thread_that_could_not_start_is_shown() {
     }
     let _ = h.get_by_label_contains("cannot start the renderer: Resource temporarily unavailable");
 }
+
+/// The tree does not shift on the first selection (Up/Down used to appear and rewrap the
+/// buttons, moving every row 23 points).
+#[test]
+fn the_first_selection_does_not_shift_the_tree() {
+    let mut h = harness(sheared("tree-shift"));
+    h.state_mut().doc.select(None);
+    h.step();
+    h.step();
+    let row = |h: &Harness<'static, TracelabApp>| h.get_by_label("Background").rect();
+    let before = row(&h);
+    let (id, _) = transforms(h.state())[1];
+    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.step();
+    h.step();
+    // The positive control: the selection took (its buttons are enabled).
+    assert_eq!(h.state().doc.selection, Some(Selection::Node(id)));
+    assert_eq!(row(&h), before);
+}

@@ -270,7 +270,10 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
             let g = &doc.scene.graph;
             let parents = g.parents();
             // Up/down move the node's slot (itself or the Transform holding it) in its Group.
+            // Always drawn (disabled where they cannot move), so the first selection does not
+            // rewrap this row and shift the tree under the pointer.
             let mut slot = node;
+            let mut place = None;
             while let Some(p) = parents.get(slot.index()).copied().flatten() {
                 if matches!(g.node(p).kind, NodeKind::Group) {
                     let pos = g
@@ -279,23 +282,34 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
                         .iter()
                         .position(|&c| c == slot)
                         .unwrap_or(0);
-                    if ui.button("Up").clicked() && pos > 0 {
-                        edits.push(Edit::MoveNode {
-                            node,
-                            new_parent: p,
-                            index: pos - 1,
-                        });
-                    }
-                    if ui.button("Down").clicked() && pos + 1 < g.node(p).children.len() {
-                        edits.push(Edit::MoveNode {
-                            node,
-                            new_parent: p,
-                            index: pos + 2,
-                        });
-                    }
+                    place = Some((p, pos, g.node(p).children.len()));
                     break;
                 }
                 slot = p;
+            }
+            let up = place.filter(|&(_, pos, _)| pos > 0);
+            if ui
+                .add_enabled(up.is_some(), egui::Button::new("Up"))
+                .clicked()
+                && let Some((p, pos, _)) = up
+            {
+                edits.push(Edit::MoveNode {
+                    node,
+                    new_parent: p,
+                    index: pos - 1,
+                });
+            }
+            let down = place.filter(|&(_, pos, n)| pos + 1 < n);
+            if ui
+                .add_enabled(down.is_some(), egui::Button::new("Down"))
+                .clicked()
+                && let Some((p, pos, _)) = down
+            {
+                edits.push(Edit::MoveNode {
+                    node,
+                    new_parent: p,
+                    index: pos + 2,
+                });
             }
             ui.menu_button("Move to", |ui| {
                 for (id, n) in g.iter() {
