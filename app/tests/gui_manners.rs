@@ -509,3 +509,27 @@ fn the_first_selection_does_not_shift_the_tree() {
     assert_eq!(h.state().doc.selection, Some(Selection::Node(id)));
     assert_eq!(row(&h), before);
 }
+
+/// Selecting a material does not widen the inspector (it grew 60 points and pushed the
+/// picture aside).
+#[test]
+fn selecting_a_material_does_not_widen_the_inspector() {
+    let mut h = harness(sheared("inspector-width"));
+    let edge = |h: &Harness<'static, TracelabApp>| {
+        h.query_all_by_role(egui::accesskit::Role::Splitter)
+            .map(|n| n.rect().center().x)
+            .max_by(f32::total_cmp)
+            .expect("a resize handle")
+    };
+    let picture = |h: &Harness<'static, TracelabApp>| h.state().shown()[0].rect;
+    let (before, view) = (edge(&h), picture(&h));
+    h.state_mut().doc.select(Some(Selection::Material(1)));
+    for _ in 0..3 {
+        h.step();
+    }
+    settle(&mut h);
+    // The positive control: the material is shown.
+    let _ = h.get_by_label("1: diffuse");
+    assert_eq!(edge(&h), before, "the inspector's edge moved");
+    assert_eq!(picture(&h), view);
+}

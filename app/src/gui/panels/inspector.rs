@@ -304,23 +304,23 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
     };
     let mut m = m.clone();
     show_refusal_for(ui, doc, Some(Place::Material(i)));
-    ui.horizontal(|ui| {
-        let mut c = m.diffuse;
-        if color(ui, &format!("{i}: diffuse"), &mut c) {
-            m.diffuse = c;
-            edits.push(Edit::SetMaterial {
-                index: i,
-                material: m.clone(),
-            });
-        }
-        if ui
-            .button("Remove")
-            .on_hover_text(format!("Remove material {i}"))
-            .clicked()
-        {
-            edits.push(Edit::RemoveMaterial { index: i });
-        }
-    });
+    // Remove under the colour, not beside it: beside, the row was wider than the panel and
+    // egui widened the inspector by 60 points, pushing the picture aside.
+    let mut c = m.diffuse;
+    if color(ui, &format!("{i}: diffuse"), &mut c) {
+        m.diffuse = c;
+        edits.push(Edit::SetMaterial {
+            index: i,
+            material: m.clone(),
+        });
+    }
+    if ui
+        .button("Remove")
+        .on_hover_text(format!("Remove material {i}"))
+        .clicked()
+    {
+        edits.push(Edit::RemoveMaterial { index: i });
+    }
 }
 
 fn node(
