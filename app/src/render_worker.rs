@@ -57,6 +57,9 @@ pub struct RenderWorker {
     cancel: Arc<AtomicBool>,
     shared: Arc<Shared>,
     thread: Option<std::thread::JoinHandle<()>>,
+    /// Why there is no render thread (the system refused one): the view says so instead of
+    /// "Rendering…" forever.
+    spawn_error: Option<String>,
     last_generation: u64,
     requests: u64,
     last_key: Option<(u32, u32, bool, ObjectRays, Vec<NormalTransform>, bool)>,
@@ -76,20 +79,41 @@ impl RenderWorker {
         let (tx, rx) = channel::<(Job, Arc<AtomicBool>)>();
         let shared = Arc::new(Shared::default());
         let s = shared.clone();
-        let thread = std::thread::Builder::new()
+        let spawned = std::thread::Builder::new()
             .name("tracelab-render".into())
-            .spawn(move || worker_loop(&rx, &s))
-            .ok();
+            .spawn(move || worker_loop(&rx, &s));
+        let (thread, spawn_error) = match spawned {
+            Ok(t) => (Some(t), None),
+            Err(e) => (None, Some(e.to_string())),
+        };
         RenderWorker {
             tx: Some(tx),
             cancel: Arc::new(AtomicBool::new(false)),
             shared,
             thread,
+            spawn_error,
             last_generation: 0,
             requests: 0,
             last_key: None,
             coarse_only: false,
         }
+    }
+
+    /// A worker whose thread could not be started, as when the system refuses one (tests of
+    /// what the window shows then).
+    pub fn failed_to_start(why: &str) -> Self {
+        let mut w = Self::new();
+        w.tx = None;
+        if let Some(t) = w.thread.take() {
+            let _ = t.join();
+        }
+        w.spawn_error = Some(why.to_string());
+        w
+    }
+
+    /// Why there is no render thread, if there is none: nothing will ever be rendered.
+    pub fn spawn_error(&self) -> Option<&str> {
+        self.spawn_error.as_deref()
     }
 
     /// Called (from the worker thread) whenever there are new pixels to show.

@@ -69,7 +69,11 @@ fn edit_save_undo(scene: PathBuf) {
     let mut h = harness(Some(scene.clone()), (48, 48));
     settle(&mut h);
     assert!(
-        h.state().doc.messages.iter().all(|m| m.contains("warning")),
+        h.state()
+            .doc
+            .messages
+            .iter()
+            .all(|m| m.text.contains("warning")),
         "{:?}",
         h.state().doc.messages
     );
@@ -168,7 +172,7 @@ fn syntax_error_shows_its_location_and_keeps_the_scene() {
     step_until(&mut h, 10, "the error", |a| !a.is_loading());
     h.step();
     assert_eq!(h.state().doc.scene, before, "the previous scene stays open");
-    let msg = h.state().doc.messages.join("\n");
+    let msg = h.state().doc.messages.joined();
     assert!(msg.contains("broken.txt:3:"), "{msg}");
     // Shown in the window, with file:line:col.
     let _ = h.get_by_label_contains("broken.txt:3:");
@@ -303,7 +307,9 @@ fn recent_files_and_view_settings_persist() {
     eframe::App::save(&mut a, &mut m);
     let mut b = TracelabApp::new(None, AppOptions::default());
     b.load_persisted(&m);
-    assert_eq!(b.recent, vec![repo("scenes/hierarchy.txt")]);
+    // Kept canonical, so the entry works from any folder (issue 26 bug 5).
+    let canonical = std::fs::canonicalize(repo("scenes/hierarchy.txt")).expect("canonical");
+    assert_eq!(b.recent, vec![canonical]);
     assert_eq!(b.view.tab, tracelab::gui::panels::viewport::Tab::Depth);
     assert_eq!(b.view.depth, (3.0, 12.5));
 }
@@ -412,7 +418,8 @@ fn a_scene_dropped_on_the_window_opens() {
     step_until(&mut h, 10, "the dropped scene", |a| {
         a.doc.path.as_deref() == Some(path.as_path())
     });
-    assert_eq!(h.state().recent.first(), Some(&path));
+    let canonical = std::fs::canonicalize(&path).expect("canonical");
+    assert_eq!(h.state().recent.first(), Some(&canonical));
 }
 
 #[test]
@@ -459,7 +466,10 @@ fn a_missing_obj_is_an_error_on_its_node_not_a_failure_to_open() {
         "the scene opened"
     );
     assert!(
-        app.doc.messages.iter().any(|m| m.contains("nowhere.obj")),
+        app.doc
+            .messages
+            .iter()
+            .any(|m| m.text.contains("nowhere.obj")),
         "{:?}",
         app.doc.messages
     );
@@ -511,6 +521,8 @@ fn adding_a_triangle_mesh_and_loading_its_obj() {
     h.step();
     h.get_by_label("Load / reload").click();
     h.step();
+    // Read on a thread (the window keeps painting): wait for it.
+    step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
     let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc.scene.graph.node(id).kind else {
         panic!("a TriangleMesh")
     };
@@ -787,7 +799,7 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     );
     h.get_by_label("Load / reload").click();
     h.step();
-    h.step();
+    step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
     let file = |app: &TracelabApp| match &app.doc.scene.graph.node(id).kind {
         NodeKind::TriangleMesh { obj_file, .. } => obj_file.clone(),
         _ => String::new(),
@@ -948,7 +960,11 @@ fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() 
     .expect("write");
     h.state_mut().open(&bad);
     step_until(&mut h, 10, "an answer", |a| {
-        a.confirm.is_some() || a.doc.messages.iter().any(|m| m.contains("broken.txt:3:"))
+        a.confirm.is_some()
+            || a.doc
+                .messages
+                .iter()
+                .any(|m| m.text.contains("broken.txt:3:"))
     });
     assert_eq!(
         h.state().confirm,
@@ -1550,7 +1566,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
         before,
         "Save wrote a file with no obj_file"
     );
-    let msg = h.state().doc.messages.join("\n");
+    let msg = h.state().doc.messages.joined();
     assert!(
         msg.contains("not saved")
             && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)),

@@ -149,7 +149,7 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
                 .doc
                 .messages
                 .iter()
-                .any(|m| m.contains("animation") || m.contains("exported"))
+                .any(|m| m.text.contains("animation") || m.text.contains("exported"))
         {
             break;
         }
@@ -159,7 +159,14 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
         );
         std::thread::sleep(Duration::from_millis(10));
     }
-    let msg = h.state().doc.messages.last().cloned().unwrap_or_default();
+    let msg = h
+        .state()
+        .doc
+        .messages
+        .iter()
+        .last()
+        .map(|n| n.text.clone())
+        .unwrap_or_default();
     assert!(msg.starts_with("exported 3 frames"), "{msg}");
     for f in [
         "frame_0000.png",
@@ -180,6 +187,6 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
             .doc
             .messages
             .iter()
-            .any(|m| m.contains("select a Transform first"))
+            .any(|m| m.text.contains("select a Transform first"))
     );
 }

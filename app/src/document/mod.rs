@@ -8,12 +8,14 @@ use tracelab_core::{MeshCache, MeshSlot, NodeId, NodeKind, Problem, Scene, check
 
 pub mod edit;
 mod error;
+pub mod notice;
 pub mod op_target;
 
 pub use error::{Misfit, OpenError, SaveError};
 
 use crate::io::{Opened, SceneRead, read_scene_file};
 use edit::{After, CoalesceKey, Edit, Refusal, apply_checked};
+use notice::{Level, Notices};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Selection {
@@ -24,6 +26,21 @@ pub enum Selection {
     Materials,
     Material(usize),
     Node(NodeId),
+}
+
+/// Reads `obj_file` (relative to `base`) into `cache` afresh: the file may have changed. Any
+/// thread; the error is kept on the node.
+pub fn read_mesh(obj_file: &str, base: Option<&Path>, cache: &mut MeshCache) -> MeshSlot {
+    match tracelab_core::format::obj::resolve_obj_path(obj_file, base) {
+        Ok(p) => {
+            cache.forget(&p);
+            match cache.load(&p) {
+                Ok(m) => MeshSlot::Loaded(m),
+                Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
+            }
+        }
+        Err(e) => MeshSlot::Failed(e.to_string()),
+    }
 }
 
 /// One state in the history: the scene and the id of that state (for the dirty flag).
@@ -40,7 +57,7 @@ pub struct Document {
     /// Bumped on every change to `scene`; the render worker drops work for older ones.
     pub generation: u64,
     /// Errors and warnings from the last open, save or edit (file:line:col for scene files).
-    pub messages: Vec<String>,
+    pub messages: Notices,
     /// Modification time of `path` when last read or written, to notice outside changes.
     pub disk_stamp: Option<SystemTime>,
     pub mesh_cache: MeshCache,
@@ -76,7 +93,7 @@ impl Document {
             path,
             selection: None,
             generation: 1,
-            messages: Vec::new(),
+            messages: Notices::default(),
             disk_stamp,
             mesh_cache: MeshCache::new(),
             lost_comments: Vec::new(),
@@ -248,19 +265,21 @@ impl Document {
     /// Sets a TriangleMesh's `obj_file` and (re)reads that file from disk, as one edit: the
     /// mesh is read again even when the name is unchanged (the file may have changed), and
     /// a file that does not load leaves the node with the error. Relative names resolve from
-    /// the document's folder.
+    /// the document's folder. Blocking; the window reads on a thread with [`read_mesh`] and
+    /// [`Self::set_mesh`].
     pub fn load_mesh(&mut self, node: NodeId, obj_file: String) -> Result<(), Refusal> {
         let base = self.path.as_deref().and_then(Path::parent);
-        let mesh = match tracelab_core::format::obj::resolve_obj_path(&obj_file, base) {
-            Ok(p) => {
-                self.mesh_cache.forget(&p);
-                match self.mesh_cache.load(&p) {
-                    Ok(m) => MeshSlot::Loaded(m),
-                    Err(e) => MeshSlot::Failed(format!("{}: {e}", p.display())),
-                }
-            }
-            Err(e) => MeshSlot::Failed(e.to_string()),
-        };
+        let mesh = read_mesh(&obj_file, base, &mut self.mesh_cache);
+        self.set_mesh(node, obj_file, mesh)
+    }
+
+    /// A TriangleMesh's file and the mesh read from it (or why not), as one edit.
+    pub fn set_mesh(
+        &mut self,
+        node: NodeId,
+        obj_file: String,
+        mesh: MeshSlot,
+    ) -> Result<(), Refusal> {
         self.apply(Edit::SetNodeKind {
             node,
             kind: NodeKind::TriangleMesh { obj_file, mesh },
@@ -311,7 +330,9 @@ impl Document {
                 let generation = self.generation + 1;
                 *self = Document::new(scene, Some(path));
                 self.mesh_cache = cache;
-                self.messages = messages;
+                for (severity, m) in messages {
+                    self.messages.push(Level::from(severity), m);
+                }
                 self.lost_comments = lost_comments;
                 // Generations stay monotonic across documents: the worker compares them.
                 self.generation = generation;
@@ -319,7 +340,10 @@ impl Document {
             }
             Err(messages) => {
                 self.mesh_cache = cache;
-                self.messages = messages.clone();
+                self.messages.clear();
+                for m in &messages {
+                    self.messages.error(m.clone());
+                }
                 Err(OpenError(messages))
             }
         }

@@ -37,6 +37,9 @@ pub struct FileDialog {
     error: Option<String>,
     /// List every file, not only those the filter names.
     all_files: bool,
+    /// A folder was entered by the first click of what may be a double-click: its second
+    /// click lands on the new folder's list and must not open the file now under it.
+    entered: bool,
 }
 
 impl FileDialog {
@@ -74,6 +77,7 @@ impl FileDialog {
             entries: Vec::new(),
             error: None,
             all_files: false,
+            entered: false,
         };
         d.refresh();
         d
@@ -172,6 +176,11 @@ impl FileDialog {
                                 name.clone()
                             };
                             let r = ui.selectable_label(*name == self.name, label);
+                            if r.double_clicked() && self.entered {
+                                // The second click of the double-click that entered here.
+                                self.entered = false;
+                                continue;
+                            }
                             if r.clicked() {
                                 if *is_dir {
                                     go = Some(self.dir.join(name));
@@ -181,6 +190,9 @@ impl FileDialog {
                             }
                             if r.double_clicked() && !is_dir {
                                 result = Some(Some(self.dir.join(name)));
+                            }
+                            if r.clicked() {
+                                self.entered = *is_dir;
                             }
                         }
                         if let Some(d) = go {

@@ -10,6 +10,14 @@ pub const MIN_VIEW_HEIGHT: f32 = 200.0;
 pub const TREE_WIDTH: f32 = 280.0;
 pub const INSPECTOR_WIDTH: f32 = 300.0;
 pub const DOCK_HEIGHT: f32 = 260.0;
+/// The smallest window (points): both side panels at their first widths and the view at
+/// least `MIN_VIEW_WIDTH` beside them, so no panel is squeezed (at 640 wide the tree's
+/// buttons wrapped letter by letter, and egui kept the squeezed width after the window grew).
+pub const MIN_WINDOW: [f32; 2] = [960.0, 600.0];
+// Checked when compiling: room for the panels' frames and resize handles (about 8 points
+// each), and for the menu, view bar and status bar above and below the dock.
+const _: () = assert!(TREE_WIDTH + INSPECTOR_WIDTH + MIN_VIEW_WIDTH + 32.0 <= MIN_WINDOW[0]);
+const _: () = assert!(DOCK_HEIGHT + MIN_VIEW_HEIGHT + 100.0 <= MIN_WINDOW[1]);
 /// egui's own minimum for a side panel.
 const MIN_PANEL: f32 = 96.0;
 

@@ -157,9 +157,28 @@ pub fn button(
     r
 }
 
-/// The commands whose keys were pressed this frame. Shortcuts with more modifiers are tried
-/// first, so Ctrl+Shift+Z does not also count as Ctrl+Z.
-pub fn shortcuts(ctx: &egui::Context) -> Vec<AppCommand> {
+/// A dialog that waits for an answer: while one is up, the scene behind it is out of reach.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dialog {
+    /// The built-in or the desktop's file dialog (Open, Save As, Export).
+    File,
+    /// "Unsaved changes" or "Saving loses something".
+    Confirm,
+}
+
+/// Whether the keys of `command` may act while `dialog` is up. Every entry of the table acts
+/// on the document or opens a dialog of its own, so none does: the keys are left to the
+/// dialog's own widgets (Delete and Ctrl+Z in its text field). Undo and Redo also wait while
+/// a text field has the keyboard, so Ctrl+Z there undoes the typing, not the scene.
+pub fn allowed(command: &AppCommand, dialog: Option<Dialog>, typing: bool) -> bool {
+    dialog.is_none() && !(typing && matches!(command, AppCommand::Undo | AppCommand::Redo))
+}
+
+/// The commands whose keys were pressed this frame, with `dialog` up (see [`allowed`]).
+/// Shortcuts with more modifiers are tried first, so Ctrl+Shift+Z does not also count as
+/// Ctrl+Z.
+pub fn shortcuts(ctx: &egui::Context, dialog: Option<Dialog>) -> Vec<AppCommand> {
+    let typing = ctx.egui_wants_keyboard_input();
     let mut all: Vec<(&KeyboardShortcut, &AppCommand)> = ENTRIES
         .iter()
         .flat_map(|e| e.keys.iter().map(move |k| (k, &e.command)))
@@ -167,8 +186,11 @@ pub fn shortcuts(ctx: &egui::Context) -> Vec<AppCommand> {
     all.sort_by_key(|(k, _)| std::cmp::Reverse(modifier_count(k.modifiers)));
     let mut out: Vec<AppCommand> = Vec::new();
     for (k, command) in all {
+        if !allowed(command, dialog, typing) {
+            continue;
+        }
         let pressed = if k.modifiers.is_none() {
-            !ctx.egui_wants_keyboard_input() && ctx.input(|i| i.key_pressed(k.logical_key))
+            !typing && ctx.input(|i| i.key_pressed(k.logical_key))
         } else {
             ctx.input_mut(|i| i.consume_shortcut(k))
         };
@@ -202,5 +224,22 @@ mod tests {
             "Save As… (Ctrl+Shift+S)"
         );
         assert_eq!(menu_text(&AppCommand::Reload), "Reload from disk");
+    }
+
+    #[test]
+    fn no_shortcut_reaches_the_scene_behind_a_dialog_and_undo_waits_for_typing() {
+        for e in ENTRIES {
+            assert!(allowed(&e.command, None, false), "{}", e.label);
+            for d in [Dialog::File, Dialog::Confirm] {
+                assert!(
+                    !allowed(&e.command, Some(d), false),
+                    "{} over {d:?}",
+                    e.label
+                );
+            }
+        }
+        assert!(!allowed(&AppCommand::Undo, None, true));
+        assert!(!allowed(&AppCommand::Redo, None, true));
+        assert!(allowed(&AppCommand::Save, None, true));
     }
 }

@@ -11,7 +11,7 @@ mod stdout;
 
 use std::path::{Path, PathBuf};
 
-use tracelab_core::{MeshCache, Scene};
+use tracelab_core::{MeshCache, Scene, Severity};
 
 pub use atomic::{AtomicFile, write_atomic};
 pub use image::{ImageWriteError, encode_image, image_format, write_image};
@@ -31,8 +31,8 @@ pub struct SceneRead {
 
 pub struct Opened {
     pub scene: Scene,
-    /// Warnings and per-node errors, `file:line:col: message`.
-    pub messages: Vec<String>,
+    /// Warnings and per-node errors, `file:line:col: message`, each with its severity.
+    pub messages: Vec<(Severity, String)>,
     /// Comments that saving would drop (see `Document::save_warnings`).
     pub lost_comments: Vec<String>,
 }
@@ -40,15 +40,19 @@ pub struct Opened {
 /// Reads and parses a scene file with its meshes.
 pub fn read_scene_file(path: &Path, mut cache: MeshCache) -> SceneRead {
     let out = tracelab_core::load_scene(path, &mut cache);
-    let messages: Vec<String> = out.diagnostics.0.iter().map(|d| d.to_string()).collect();
+    let messages = out
+        .diagnostics
+        .0
+        .iter()
+        .map(|d| (d.severity, d.to_string()));
     let lost_comments = out.lost_comments.iter().map(|d| d.to_string()).collect();
     let outcome = match out.scene {
         Some(scene) => Ok(Opened {
             scene,
-            messages,
+            messages: messages.collect(),
             lost_comments,
         }),
-        None => Err(messages),
+        None => Err(messages.map(|(_, m)| m).collect()),
     };
     SceneRead {
         path: path.to_path_buf(),

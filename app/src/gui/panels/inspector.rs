@@ -2,7 +2,6 @@
 //! [`Edit`]s (and, for a TriangleMesh's file, [`AppCommand::LoadMesh`]). Widgets edit copies;
 //! nothing here changes the document or reads files.
 
-use egui::DragValue;
 use glam::{Mat4, Vec3};
 use tracelab_core::{
     Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
@@ -12,6 +11,7 @@ use crate::document::edit::{Edit, Refusal};
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::drag_speed::{DragSpeeds, world_per_unit};
+use crate::gui::widgets::{number, render_from_swatch, swatch_from_render};
 
 pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
     let mut edits = Vec::new();
@@ -80,7 +80,7 @@ pub fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
     ui.horizontal(|ui| {
         ui.label(name);
         for (axis, c) in [("x", &mut v.x), ("y", &mut v.y), ("z", &mut v.z)] {
-            let r = ui.add(DragValue::new(&mut *c).speed(speed).max_decimals(4));
+            let r = number(ui, &mut *c, |d| d.speed(speed).max_decimals(4));
             name_widget(&r, format!("{name} {axis}"), f64::from(*c));
             changed |= r.changed();
         }
@@ -103,7 +103,7 @@ fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
     let changed = ui
         .horizontal(|ui| {
             ui.label(name);
-            let r = ui.add(DragValue::new(&mut *v).speed(speed).max_decimals(4));
+            let r = number(ui, &mut *v, |d| d.speed(speed).max_decimals(4));
             name_widget(&r, name.to_string(), f64::from(*v));
             r.changed()
         })
@@ -183,17 +183,16 @@ fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
         .horizontal(|ui| {
             ui.label(name);
             let mut rgb = c.to_array();
-            let changed = ui.color_edit_button_rgb(&mut rgb).changed();
+            // The swatch in the render's colour space (see `swatch_from_render`).
+            let mut swatch = swatch_from_render(rgb);
+            let changed = ui.color_edit_button_rgb(&mut swatch).changed();
+            if changed {
+                rgb = render_from_swatch(swatch);
+            }
             let mut changed2 = false;
             for v in &mut rgb {
-                changed2 |= ui
-                    .add(
-                        DragValue::new(v)
-                            .speed(0.005)
-                            .range(0.0..=4.0)
-                            .max_decimals(3),
-                    )
-                    .changed();
+                changed2 |=
+                    number(ui, v, |d| d.speed(0.005).range(0.0..=4.0).max_decimals(3)).changed();
             }
             *c = Vec3::from_array(rgb);
             changed || changed2
@@ -305,23 +304,23 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
     };
     let mut m = m.clone();
     show_refusal_for(ui, doc, Some(Place::Material(i)));
-    ui.horizontal(|ui| {
-        let mut c = m.diffuse;
-        if color(ui, &format!("{i}: diffuse"), &mut c) {
-            m.diffuse = c;
-            edits.push(Edit::SetMaterial {
-                index: i,
-                material: m.clone(),
-            });
-        }
-        if ui
-            .button("Remove")
-            .on_hover_text(format!("Remove material {i}"))
-            .clicked()
-        {
-            edits.push(Edit::RemoveMaterial { index: i });
-        }
-    });
+    // Remove under the colour, not beside it: beside, the row was wider than the panel and
+    // egui widened the inspector by 60 points, pushing the picture aside.
+    let mut c = m.diffuse;
+    if color(ui, &format!("{i}: diffuse"), &mut c) {
+        m.diffuse = c;
+        edits.push(Edit::SetMaterial {
+            index: i,
+            material: m.clone(),
+        });
+    }
+    if ui
+        .button("Remove")
+        .on_hover_text(format!("Remove material {i}"))
+        .clicked()
+    {
+        edits.push(Edit::RemoveMaterial { index: i });
+    }
 }
 
 fn node(
@@ -621,9 +620,7 @@ fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
     egui::Grid::new("matrix").show(ui, |ui| {
         for row in &mut rows {
             for c in row.iter_mut() {
-                changed |= ui
-                    .add(DragValue::new(c).speed(0.01).max_decimals(4))
-                    .changed();
+                changed |= number(ui, c, |d| d.speed(0.01).max_decimals(4)).changed();
             }
             ui.end_row();
         }

@@ -4,16 +4,17 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use tracelab_core::render::{RayStory, inspect_pixel};
-use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
+use tracelab_core::{Camera, NormalTransform, ObjectRays, RenderSettings, Scene};
 
 use crate::gui::widgets::ascii_math;
+use crate::navigation::ViewBasis;
 use crate::render_worker::Published;
 use crate::story::{HitReport, TransformReport, hit_report, transform_lines};
 
 /// The pixel being inspected, and the render its story was traced in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Inspected {
     /// Which image: 0, or 1 for the Incorrect rule in compare mode.
     pub frame: usize,
@@ -23,6 +24,9 @@ pub struct Inspected {
     pub size: (u32, u32),
     /// The render request the story belongs to.
     pub request: u64,
+    /// The camera it was picked with: while it stays, a resized image (the dock opening)
+    /// follows the same ray, not the same fraction of the image.
+    pub camera: Camera,
 }
 
 /// Traces pixel (`x`, `row`) of image `frame` of a published render.
@@ -43,14 +47,17 @@ pub fn trace(
         row: row.min(settings.height.saturating_sub(1)),
         size: (settings.width, settings.height),
         request: p.job.request,
+        camera: p.job.scene.camera.clone(),
     };
     let story = inspect_pixel(&p.job.scene, &p.compiled, &settings, at.x, at.row);
     Some((at, story, p.job.scene.clone()))
 }
 
-/// The same pixel traced in a newer render: the same place in the image when its size
-/// changed, and the first image when the one it was in is gone (compare mode turned off).
-/// `None` when `p` is the render `at` was traced in.
+/// The same pixel traced in a newer render: the pixel the same ray goes through when only
+/// the image's size changed (so a pick describes what was under the pointer, even after the
+/// view shrinks), else the same place in the image; and the first image when the one it was
+/// in is gone (compare mode turned off). `None` when `p` is the render `at` was traced in,
+/// or when the picked ray is no longer in the image (the story from before stays).
 pub fn follow(p: &Published, at: &Inspected) -> Option<(Inspected, RayStory, Arc<Scene>)> {
     if p.job.request == at.request {
         return None;
@@ -64,12 +71,21 @@ pub fn follow(p: &Published, at: &Inspected) -> Option<(Inspected, RayStory, Arc
     } else {
         0
     };
-    trace(
-        p,
-        frame,
-        scale(at.x, at.size.0, w),
-        scale(at.row, at.size.1, h),
-    )
+    let (x, row) = if p.job.scene.camera == at.camera {
+        same_ray(at, w, h)?
+    } else {
+        (scale(at.x, at.size.0, w), scale(at.row, at.size.1, h))
+    };
+    trace(p, frame, x, row)
+}
+
+/// The pixel of a `w`×`h` image, same camera, that `at`'s ray goes through.
+fn same_ray(at: &Inspected, w: u32, h: u32) -> Option<(u32, u32)> {
+    let old = ViewBasis::new(&at.camera, at.size.0, at.size.1);
+    let (origin, dir) = old.ray(Vec2::new(at.x as f32 + 0.5, at.row as f32 + 0.5));
+    let px = ViewBasis::new(&at.camera, w, h).project(origin + dir)?;
+    let inside = px.x >= 0.0 && px.y >= 0.0 && px.x < w as f32 && px.y < h as f32;
+    inside.then_some((px.x as u32, px.y as u32))
 }
 
 fn v(v: Vec3) -> String {

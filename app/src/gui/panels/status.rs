@@ -43,10 +43,10 @@ pub fn ui(
             "{} objects · {} triangles · {} nodes",
             stats.0, stats.1, stats.2
         ));
-        let errors = doc.messages.len();
-        if errors > 0 {
+        if let Some(worst) = doc.messages.worst() {
             ui.separator();
-            ui.colored_label(ui.visuals().warn_fg_color, format!("{errors} message(s)"));
+            let colour = crate::gui::notifications::colour(ui, worst);
+            ui.colored_label(colour, format!("{} message(s)", doc.messages.len()));
         }
         ui.separator();
         ui.label(format!("generation {}", doc.generation));

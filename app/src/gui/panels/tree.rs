@@ -121,7 +121,7 @@ pub fn ui(
                     {
                         swatch(ui, mat.diffuse);
                     }
-                    let mut text = row.label.clone();
+                    let mut text = short_numbers(&row.label);
                     if let Some(m) = row.material {
                         text.push_str(&format!("  [mat {m}]"));
                     }
@@ -131,9 +131,11 @@ pub fn ui(
                         label = label.color(ui.visuals().error_fg_color);
                     }
                     let r = ui.selectable_label(sel == Some(s), label);
+                    // The full text (a row is cut at the panel's edge, and its numbers are
+                    // rounded as the inspector's are), and the error when there is one.
                     let r = match &row.error {
-                        Some(e) => r.on_hover_text(e),
-                        None => r,
+                        Some(e) => r.on_hover_text(format!("{}\n{e}", row.label)),
+                        None => r.on_hover_text(&row.label),
                     };
                     if r.clicked() {
                         clicked = Some(s);
@@ -264,7 +266,10 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
             let g = &doc.scene.graph;
             let parents = g.parents();
             // Up/down move the node's slot (itself or the Transform holding it) in its Group.
+            // Always drawn (disabled where they cannot move), so the first selection does not
+            // rewrap this row and shift the tree under the pointer.
             let mut slot = node;
+            let mut place = None;
             while let Some(p) = parents.get(slot.index()).copied().flatten() {
                 if matches!(g.node(p).kind, NodeKind::Group) {
                     let pos = g
@@ -273,23 +278,34 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
                         .iter()
                         .position(|&c| c == slot)
                         .unwrap_or(0);
-                    if ui.button("Up").clicked() && pos > 0 {
-                        edits.push(Edit::MoveNode {
-                            node,
-                            new_parent: p,
-                            index: pos - 1,
-                        });
-                    }
-                    if ui.button("Down").clicked() && pos + 1 < g.node(p).children.len() {
-                        edits.push(Edit::MoveNode {
-                            node,
-                            new_parent: p,
-                            index: pos + 2,
-                        });
-                    }
+                    place = Some((p, pos, g.node(p).children.len()));
                     break;
                 }
                 slot = p;
+            }
+            let up = place.filter(|&(_, pos, _)| pos > 0);
+            if ui
+                .add_enabled(up.is_some(), egui::Button::new("Up"))
+                .clicked()
+                && let Some((p, pos, _)) = up
+            {
+                edits.push(Edit::MoveNode {
+                    node,
+                    new_parent: p,
+                    index: pos - 1,
+                });
+            }
+            let down = place.filter(|&(_, pos, n)| pos + 1 < n);
+            if ui
+                .add_enabled(down.is_some(), egui::Button::new("Down"))
+                .clicked()
+                && let Some((p, pos, _)) = down
+            {
+                edits.push(Edit::MoveNode {
+                    node,
+                    new_parent: p,
+                    index: pos + 2,
+                });
             }
             ui.menu_button("Move to", |ui| {
                 for (id, n) in g.iter() {
@@ -312,4 +328,64 @@ fn toolbar(ui: &mut egui::Ui, doc: &Document, edits: &mut Vec<Edit>) {
             });
         });
     });
+}
+
+/// Decimals the tree shows, as the inspector's fields do.
+const DECIMALS: usize = 4;
+
+/// `label` with every number of more than [`DECIMALS`] decimals rounded to that many
+/// ("Translate(2.7747805, 0, 0)" reads "Translate(2.7748, 0, 0)").
+pub fn short_numbers(label: &str) -> String {
+    let mut out = String::with_capacity(label.len());
+    let chars: Vec<char> = label.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let starts_number = chars[i].is_ascii_digit()
+            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '.'));
+        if !starts_number {
+            out.push(chars[i]);
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < chars.len() && chars[i].is_ascii_digit() {
+            i += 1;
+        }
+        let mut decimals = 0;
+        if i + 1 < chars.len() && chars[i] == '.' && chars[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < chars.len() && chars[i].is_ascii_digit() {
+                i += 1;
+                decimals += 1;
+            }
+        }
+        let number: String = chars[start..i].iter().collect();
+        let exponent = i < chars.len() && matches!(chars[i], 'e' | 'E');
+        match number.parse::<f64>() {
+            Ok(v) if decimals > DECIMALS && !exponent => {
+                let t = format!("{v:.DECIMALS$}");
+                out.push_str(t.trim_end_matches('0').trim_end_matches('.'));
+            }
+            _ => out.push_str(&number),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tree_labels_round_long_numbers_as_the_inspector_does() {
+        assert_eq!(
+            short_numbers("Transform: Translate(2.7747805, -0.5, 0) · Scale(1, 1e-7, 3.00001)"),
+            "Transform: Translate(2.7748, -0.5, 0) · Scale(1, 1e-7, 3)"
+        );
+        assert_eq!(
+            short_numbers("Sphere: (0, 0, 0) r 1  [mat 2]"),
+            "Sphere: (0, 0, 0) r 1  [mat 2]"
+        );
+        assert_eq!(short_numbers("Box2: 0.123456789"), "Box2: 0.1235");
+    }
 }

@@ -11,6 +11,7 @@ use crate::gui::gizmo::Axes;
 use crate::gui::on_screen::OnScreen;
 use crate::gui::overlays;
 use crate::gui::view_tools::ViewTools;
+use crate::gui::widgets::number;
 use crate::render_worker::{Published, RenderWorker};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -133,6 +134,22 @@ pub struct Drawn {
     pub uv: egui::Rect,
 }
 
+impl Drawn {
+    /// The part of `rect` (showing `uv` of the texture) inside `clip`, with its own uv.
+    fn clipped(texture: usize, rect: egui::Rect, uv: egui::Rect, clip: egui::Rect) -> Self {
+        let shown = rect.intersect(clip);
+        let at = |p: egui::Pos2| {
+            let t = (p - rect.min) / rect.size();
+            uv.min + t * uv.size()
+        };
+        Drawn {
+            texture,
+            rect: shown,
+            uv: egui::Rect::from_min_max(at(shown.min), at(shown.max)),
+        }
+    }
+}
+
 /// Pixels the view put on screen: what the texture held when it was drawn.
 #[derive(Clone, Debug)]
 pub struct Shown {
@@ -249,8 +266,8 @@ impl Viewport {
             ui.checkbox(&mut s.shade_back, "shade back");
             ui.separator();
             // "depth" inside the first value, so no lone label ends a row of the bar.
-            ui.add(egui::DragValue::new(&mut s.depth.0).speed(0.05).prefix("depth min "));
-            ui.add(egui::DragValue::new(&mut s.depth.1).speed(0.05).prefix("max "));
+            number(ui, &mut s.depth.0, |d| d.speed(0.05).prefix("depth min "));
+            number(ui, &mut s.depth.1, |d| d.speed(0.05).prefix("max "));
             ui.separator();
             let mut fixed = s.fixed_size.is_some();
             if ui.checkbox(&mut fixed, "fixed size").changed() {
@@ -262,8 +279,8 @@ impl Viewport {
                 // Whole numbers only: "nan" once parsed, was clamped and became 4096.
                 let parse = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
                 let side = 1..=MAX_IMAGE_SIDE;
-                ui.add(egui::DragValue::new(&mut size.0).range(side.clone()).custom_parser(parse).suffix(" w"));
-                ui.add(egui::DragValue::new(&mut size.1).range(side).custom_parser(parse).suffix(" h"));
+                number(ui, &mut size.0, |d| d.range(side.clone()).custom_parser(parse).suffix(" w"));
+                number(ui, &mut size.1, |d| d.range(side).custom_parser(parse).suffix(" h"));
                 if *size != before {
                     // The same limits as the command line: refuse, keep the last good size, say why.
                     let refused = check_image_size(size.0, size.1).err().map(|e| e.to_string());
@@ -303,7 +320,9 @@ impl Viewport {
     }
 
     /// Draws the images with the gizmo and overlays, queues what the mouse tools ask for,
-    /// and returns a pick when the user clicked a pixel.
+    /// and returns a pick when the user clicked a pixel. `hidden_below`: the height a panel
+    /// under the view (the dock) takes from it; the images are laid out as if it were not
+    /// there and clipped, so that panel never moves or rescales them.
     pub fn images(
         &mut self,
         ui: &mut egui::Ui,
@@ -311,6 +330,7 @@ impl Viewport {
         worker: &RenderWorker,
         doc: &Document,
         out: &mut Vec<AppCommand>,
+        hidden_below: f32,
     ) -> Option<Pick> {
         let cells = s.cells();
         let ctx = ui.ctx().clone();
@@ -319,7 +339,13 @@ impl Viewport {
         self.tools.begin_frame();
         worker.with_published(|p| {
             let Some(p) = p else {
-                ui.label("Rendering…");
+                match worker.spawn_error() {
+                    Some(e) => ui.colored_label(
+                        ui.visuals().error_fg_color,
+                        format!("cannot start the renderer: {e}"),
+                    ),
+                    None => ui.label("Rendering…"),
+                };
                 return;
             };
             self.upload(&ctx, p, s);
@@ -342,6 +368,8 @@ impl Viewport {
                     egui::Sense::click_and_drag(),
                 );
                 let mut img_area = cell;
+                img_area.max.y += hidden_below;
+                let painter = ui.painter().with_clip_rect(cell.intersect(ui.clip_rect()));
                 if !caption.is_empty() {
                     ui.painter().text(
                         cell.left_top() + egui::vec2(4.0, 2.0),
@@ -380,23 +408,14 @@ impl Viewport {
                         egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(s.split, 1.0));
                     let ruv =
                         egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
-                    ui.painter()
-                        .image(tex.id(), left, luv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn {
-                        texture: tex_i,
-                        rect: left,
-                        uv: luv,
-                    });
+                    painter.image(tex.id(), left, luv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn::clipped(tex_i, left, luv, cell));
                     if let Some(o) = other {
-                        ui.painter().image(o.id(), right, ruv, egui::Color32::WHITE);
+                        painter.image(o.id(), right, ruv, egui::Color32::WHITE);
                         let texture = self.tex_index(1, view);
-                        self.drawn.push(Drawn {
-                            texture,
-                            rect: right,
-                            uv: ruv,
-                        });
+                        self.drawn.push(Drawn::clipped(texture, right, ruv, cell));
                     }
-                    ui.painter().vline(
+                    painter.vline(
                         xs,
                         rect.y_range(),
                         egui::Stroke::new(2.0, egui::Color32::YELLOW),
@@ -407,12 +426,8 @@ impl Viewport {
                         s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
                     }
                 } else {
-                    ui.painter().image(tex.id(), rect, uv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn {
-                        texture: tex_i,
-                        rect,
-                        uv,
-                    });
+                    painter.image(tex.id(), rect, uv, egui::Color32::WHITE);
+                    self.drawn.push(Drawn::clipped(tex_i, rect, uv, cell));
                 }
                 let view = OnScreen::new(&doc.scene.camera, w as u32, h as u32, rect);
                 let surface = |px: glam::Vec2| surface_point(worker, frame, px);
@@ -420,7 +435,7 @@ impl Viewport {
                     .tools
                     .cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
                 if s.overlays {
-                    let painter = ui.painter().with_clip_rect(rect);
+                    let painter = painter.with_clip_rect(rect.intersect(painter.clip_rect()));
                     if let Some(o) = &self.outline {
                         painter.image(o.id(), rect, uv, egui::Color32::WHITE);
                     }
@@ -437,15 +452,17 @@ impl Viewport {
                             (my as f32 + 0.5) / h as f32 * rect.height(),
                         );
                     let stroke = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 0, 255));
-                    ui.painter().circle_stroke(c, 6.0, stroke);
-                    ui.painter().hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
-                    ui.painter().hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
-                    ui.painter().vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
-                    ui.painter().vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
+                    painter.circle_stroke(c, 6.0, stroke);
+                    painter.hline((c.x - 10.0)..=(c.x - 3.0), c.y, stroke);
+                    painter.hline((c.x + 3.0)..=(c.x + 10.0), c.y, stroke);
+                    painter.vline(c.x, (c.y - 10.0)..=(c.y - 3.0), stroke);
+                    painter.vline(c.x, (c.y + 3.0)..=(c.y + 10.0), stroke);
                 }
                 if resp.clicked()
                     && !used
-                    && let Some(pos) = resp.interact_pointer_pos().filter(|p| rect.contains(*p))
+                    && let Some(pos) = resp
+                        .interact_pointer_pos()
+                        .filter(|p| rect.contains(*p) && cell.contains(*p))
                 {
                     let u = (pos.x - rect.left()) / rect.width();
                     let v = (pos.y - rect.top()) / rect.height();
