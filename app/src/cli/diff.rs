@@ -518,7 +518,7 @@ fn region_text(
 }
 
 /// The criterion of `--tolerance` and `--min-match`, checked.
-fn criterion(a: &DiffArgs) -> anyhow::Result<Criterion> {
+pub(super) fn criterion(a: &DiffArgs) -> anyhow::Result<Criterion> {
     if !(0.0..=100.0).contains(&a.min_match) {
         return Err(usage(format!(
             "--min-match {}: expected a percentage from 0 to 100",
@@ -533,9 +533,6 @@ fn criterion(a: &DiffArgs) -> anyhow::Result<Criterion> {
 
 pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     let criterion = criterion(a)?;
-    if let Some(commands) = &a.batch {
-        return super::batch::run_batch(a, commands, &criterion);
-    }
     let Some(image) = a.image.as_deref() else {
         return Err(usage(
             "diff needs IMAGE -- COURSE-COMMAND-LINE, or --batch COMMANDS.txt --images DIR",

@@ -175,7 +175,12 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Render(r)) => run_render(&render::render_job(r)?),
         Some(Command::Inspect(a)) => inspect::run_inspect(&a),
-        Some(Command::Diff(a)) => diff::run_diff(&a),
+        // `--batch` is dispatched here, not from diff.rs, so batch.rs (which uses diff.rs's
+        // judging) and diff.rs do not import each other.
+        Some(Command::Diff(a)) => match &a.batch {
+            Some(commands) => batch::run_batch(&a, commands, &diff::criterion(&a)?),
+            None => diff::run_diff(&a),
+        },
         Some(Command::Animate(a)) => animate::run_animate(&a),
         Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
