@@ -6,7 +6,8 @@
 use glam::{DMat3, DMat4, Vec3};
 use serde::Serialize;
 use tracelab_core::render::{
-    Breaks, HitStory, RayStory, SimilitudeTest, depth_shade, quantize, similitude,
+    Breaks, Cut, HitStory, RayKind, RayNode, RayStory, SimilitudeTest, depth_shade, quantize,
+    similitude,
 };
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, Scene};
 
@@ -32,6 +33,183 @@ pub struct PixelReport {
     pub rgb8: [u8; 3],
     /// The bytes each of the course's images holds at this pixel.
     pub images: ImageBytes,
+    /// Assignments 3–4: the eye ray's tree of shadow, reflected and refracted rays; `None`
+    /// (JSON null) where the scene and settings need only the lecture's diffuse shading.
+    pub ray_tree: Option<RayTreeReport>,
+}
+
+/// One ray of a pixel's ray tree (`tracelab_core::render::RayNode`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RayTreeReport {
+    /// "eye", "reflected" or "refracted".
+    pub kind: &'static str,
+    pub ray: RayReport,
+    /// The product of the colours this ray is seen through, as a length (1 for the eye ray).
+    pub weight: f32,
+    /// The material colour what it brings back is multiplied by (reflective or transparent).
+    pub factor: [f32; 3],
+    /// `None` (null) for a miss: the ray brings back the background.
+    pub hit: Option<TreeHitReport>,
+    /// c_ambient·k_d.
+    pub ambient: [f32; 3],
+    /// Each light's diffuse + specular share (zero in shadow or from behind).
+    pub lights: Vec<LightShareReport>,
+    pub shadow_rays: Vec<ShadowReport>,
+    /// Secondary rays not traced: "bounces" (-bounces used up), "weight" (below -weight)
+    /// or "total internal reflection".
+    pub not_traced: Vec<CutReport>,
+    pub children: Vec<RayTreeReport>,
+    /// What the ray brings back, before `factor`.
+    pub color: [f32; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TreeHitReport {
+    pub t: f32,
+    pub node: Option<u32>,
+    pub point: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LightShareReport {
+    pub light: usize,
+    pub color: [f32; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShadowReport {
+    pub light: usize,
+    pub ray: RayReport,
+    /// Distance to the light; null for a directional light.
+    pub distance: Option<f32>,
+    pub blocked: bool,
+    /// The nearest blocker's t along the shadow ray and its node.
+    pub blocker_t: Option<f32>,
+    pub blocker_node: Option<u32>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CutReport {
+    pub kind: &'static str,
+    pub why: &'static str,
+    /// For "weight": the weight it would have had.
+    pub weight: Option<f32>,
+}
+
+fn ray_kind_name(k: RayKind) -> &'static str {
+    match k {
+        RayKind::Eye => "eye",
+        RayKind::Reflected => "reflected",
+        RayKind::Refracted => "refracted",
+    }
+}
+
+/// The report of one ray of the tree and everything below it.
+pub fn ray_tree_report(n: &RayNode) -> RayTreeReport {
+    RayTreeReport {
+        kind: ray_kind_name(n.kind),
+        ray: ray(&n.ray),
+        weight: n.weight,
+        factor: a3(n.factor),
+        hit: n.hit.map(|(t, node, point, normal)| TreeHitReport {
+            t,
+            node: node.map(|id| id.0),
+            point: a3(point),
+            normal: a3(normal),
+        }),
+        ambient: a3(n.ambient),
+        lights: n
+            .lights
+            .iter()
+            .map(|l| LightShareReport {
+                light: l.light,
+                color: a3(l.color),
+            })
+            .collect(),
+        shadow_rays: n
+            .shadows
+            .iter()
+            .map(|s| ShadowReport {
+                light: s.light,
+                ray: ray(&s.ray),
+                distance: s.distance.is_finite().then_some(s.distance),
+                blocked: s.blocker.is_some(),
+                blocker_t: s.blocker.map(|b| b.0),
+                blocker_node: s.blocker.and_then(|b| b.1).map(|id| id.0),
+            })
+            .collect(),
+        not_traced: n
+            .cuts
+            .iter()
+            .map(|&(kind, why)| CutReport {
+                kind: ray_kind_name(kind),
+                why: match why {
+                    Cut::Bounces => "bounces",
+                    Cut::Weight { .. } => "weight",
+                    Cut::TotalInternalReflection => "total internal reflection",
+                },
+                weight: match why {
+                    Cut::Weight { weight } => Some(weight),
+                    _ => None,
+                },
+            })
+            .collect(),
+        children: n.children.iter().map(ray_tree_report).collect(),
+        color: a3(n.color),
+    }
+}
+
+/// The tree as indented text lines, one ray (and its shadow rays and cut-offs) a few lines,
+/// for `tracelab inspect` and the pixel inspector.
+pub fn ray_tree_lines(r: &RayTreeReport, depth: usize, out: &mut Vec<String>) {
+    let ind = "  ".repeat(depth);
+    let hit = match &r.hit {
+        Some(h) => format!(
+            "hit node {} at t = {:.5}",
+            h.node.map_or("?".to_string(), |n| n.to_string()),
+            h.t
+        ),
+        None => "missed: background".to_string(),
+    };
+    let factor = if r.kind == "eye" {
+        String::new()
+    } else {
+        format!(" × {} (weight {:.4})", v3(r.factor), r.weight)
+    };
+    out.push(format!(
+        "{ind}{} ray{factor}: {hit} -> {}",
+        r.kind,
+        v3(r.color)
+    ));
+    if r.hit.is_some() {
+        out.push(format!("{ind}  ambient·k_d {}", v3(r.ambient)));
+    }
+    for l in &r.lights {
+        let shadow = r.shadow_rays.iter().find(|s| s.light == l.light);
+        let note = match shadow {
+            Some(s) if s.blocked => format!(
+                " (shadow ray blocked at t = {:.5}{})",
+                s.blocker_t.unwrap_or(f32::NAN),
+                s.blocker_node
+                    .map_or(String::new(), |n| format!(" by node {n}"))
+            ),
+            Some(_) => " (shadow ray reaches it)".to_string(),
+            None => String::new(),
+        };
+        out.push(format!("{ind}  light {} {}{note}", l.light, v3(l.color)));
+    }
+    for c in &r.not_traced {
+        let why = match c.weight {
+            Some(w) => format!("weight {w:.4} below -weight"),
+            None if c.why == "bounces" => "-bounces used up".to_string(),
+            None => c.why.to_string(),
+        };
+        out.push(format!("{ind}  {} ray not traced: {why}", c.kind));
+    }
+    for c in &r.children {
+        ray_tree_lines(c, depth + 1, out);
+    }
 }
 
 /// What the `-output`, `-normals` and `-depth` images hold at the pixel, so a student need
@@ -69,6 +247,10 @@ pub struct SettingsReport {
     pub object_rays: &'static str,
     pub normal_transform: &'static str,
     pub shade_back: bool,
+    pub shadows: bool,
+    pub bounces: u32,
+    pub weight: f32,
+    pub specular_fix: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -380,6 +562,10 @@ pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) 
             object_rays: object_rays_name(settings.object_rays),
             normal_transform: normal_rule_name(settings.normal_transform),
             shade_back: settings.shade_back,
+            shadows: settings.secondary.shadows,
+            bounces: settings.secondary.bounces,
+            weight: settings.secondary.weight,
+            specular_fix: settings.secondary.specular_fix,
         },
         world_ray: ray(&story.world_ray),
         hit: story
@@ -397,6 +583,7 @@ pub fn pixel_report(scene: &Scene, story: &RayStory, settings: &RenderSettings) 
                 .map_or([0; 3], |h| quantize3(h.shade.normal.abs())),
             depth: None,
         },
+        ray_tree: story.ray_tree.as_ref().map(ray_tree_report),
     }
 }
 
@@ -546,6 +733,13 @@ pub fn report_text(r: &PixelReport) -> String {
         ));
     }
     let label = if black { "colour" } else { "sum" };
+    if let Some(tree) = &r.ray_tree {
+        out.push(
+            "ray tree (highlights, shadow rays, reflection, refraction; the sum is the pixel's colour):"
+                .into(),
+        );
+        ray_tree_lines(tree, 1, &mut out);
+    }
     out.push(format!(
         "  {label:<23}{} -> bytes {:?}",
         v3(r.color),

@@ -1669,13 +1669,13 @@ fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
     }
     let _ = h.get_by_label("DirectionalLight: direction must not be zero");
     assert_eq!(
-        h.state().doc.scene.lights()[0].direction,
-        Vec3::new(0.0, 0.0, -1.0)
+        h.state().doc.scene.lights()[0].direction(),
+        Some(Vec3::new(0.0, 0.0, -1.0))
     );
     ctrl_s(&mut h);
     assert_eq!(
-        reopened(&path).lights()[0].direction,
-        Vec3::new(0.0, 0.0, -1.0)
+        reopened(&path).lights()[0].direction(),
+        Some(Vec3::new(0.0, 0.0, -1.0))
     );
 }
 

@@ -3,14 +3,39 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
+use tracelab_core::render::Secondary;
 use tracelab_core::{NormalTransform, ObjectRays};
 
 use super::render::RenderJob;
-use super::values::{parse_f32, parse_u32};
+use super::values::{parse_count, parse_f32, parse_u32};
 use crate::exit::usage;
+use crate::io::write_stderr_text;
+
+/// The most levels of secondary rays `-bounces` takes: deeper than any course scene needs
+/// (10), and shallow enough that the recursion stays well inside a thread's stack.
+pub const MAX_BOUNCES: u32 = 100;
+
+/// Flags of the course's later weeks that tracelab does not implement yet: refused by name,
+/// never ignored (an image made without them would be silently wrong).
+const NOT_YET: [(&str, &str); 11] = [
+    ("-grid", "assignment 5's uniform grid"),
+    ("-visualize_grid", "assignment 5's grid view"),
+    ("-stats", "assignment 6's counters"),
+    ("-random_samples", "assignment 7's sampling"),
+    ("-uniform_samples", "assignment 7's sampling"),
+    ("-jittered_samples", "assignment 7's sampling"),
+    ("-box_filter", "assignment 7's filters"),
+    ("-tent_filter", "assignment 7's filters"),
+    ("-gaussian_filter", "assignment 7's filters"),
+    ("-render_samples", "assignment 7's sample view"),
+    ("-render_filter", "assignment 7's filter view"),
+];
 
 /// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
-/// -shade_back`, plus tracelab's `-normal_transform correct|incorrect` and
+/// -shade_back` (assignments 1–2), `-shadows -bounces N -weight W` (assignment 4), the
+/// OpenGL preview's `-gui -tessellation A B -gouraud` (accepted, with a note: the editor is
+/// tracelab's preview), plus tracelab's `-specular_fix` (assignment 3's optional fix),
+/// `-normal_transform correct|incorrect` and
 /// `-object_rays unnormalized|normalized|normalized-no-rescale`.
 pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     let mut job = RenderJob {
@@ -23,7 +48,9 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
         shade_back: false,
         normal_transform: NormalTransform::Correct,
         object_rays: ObjectRays::Unnormalized,
+        secondary: Secondary::default(),
     };
+    let mut preview = Vec::new();
     let mut it = args.iter();
     let take = |it: &mut std::slice::Iter<OsString>, flag: &str| -> anyhow::Result<OsString> {
         it.next()
@@ -47,6 +74,39 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
                 job.depth = Some((min, max, PathBuf::from(take(&mut it, a)?)));
             }
             "-shade_back" => job.shade_back = true,
+            "-shadows" => job.secondary.shadows = true,
+            "-specular_fix" => job.secondary.specular_fix = true,
+            "-bounces" => {
+                let n = parse_count(&take(&mut it, a)?, "-bounces")?;
+                if n > MAX_BOUNCES {
+                    return Err(usage(format!(
+                        "-bounces: at most {MAX_BOUNCES} levels, found {n}"
+                    )));
+                }
+                job.secondary.bounces = n;
+            }
+            "-weight" => {
+                let w = parse_f32(&take(&mut it, a)?, "-weight")?;
+                if !(w.is_finite() && w >= 0.0) {
+                    return Err(usage(format!(
+                        "-weight: expected a number of 0 or more, found {w}"
+                    )));
+                }
+                job.secondary.weight = w;
+            }
+            "-gui" | "-gouraud" => preview.push(a.to_string()),
+            "-tessellation" => {
+                let th = parse_u32(&take(&mut it, a)?, "-tessellation theta steps")?;
+                let ph = parse_u32(&take(&mut it, a)?, "-tessellation phi steps")?;
+                preview.push(format!("-tessellation {th} {ph}"));
+            }
+            _ if NOT_YET.iter().any(|(f, _)| *f == a) => {
+                let what = NOT_YET.iter().find(|(f, _)| *f == a).map_or("", |(_, w)| w);
+                return Err(usage(format!(
+                    "{a} ({what}) is not implemented by tracelab yet; \
+                     an image rendered without it would not be the course's"
+                )));
+            }
             "-normal_transform" => {
                 let v = take(&mut it, a)?;
                 job.normal_transform = match v.to_str() {
@@ -71,7 +131,7 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
             }
             _ => {
                 return Err(usage(format!(
-                    "unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back)",
+                    "unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back -shadows -bounces -weight)",
                     arg.display()
                 )));
             }
@@ -82,6 +142,13 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     }
     if job.width == 0 {
         return Err(usage("-size W H is required"));
+    }
+    if !preview.is_empty() {
+        write_stderr_text(&format!(
+            "tracelab: note: {} only set the course's OpenGL preview, which tracelab does not \
+             open; the editor is tracelab's preview: `tracelab SCENE`\n",
+            preview.join(", ")
+        ));
     }
     Ok(job)
 }

@@ -344,6 +344,7 @@ pub(super) fn judge_line<'s>(
         shade_back: job.shade_back,
         normal_transform: job.normal_transform,
         object_rays: job.object_rays,
+        secondary: job.secondary,
         ..RenderSettings::new(job.width, job.height)
     };
     let frame = render_with_progress(&compiled, &settings)?;

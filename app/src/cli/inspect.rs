@@ -50,6 +50,8 @@ pub struct InspectArgs {
     /// for it.
     #[arg(long, num_args = 2, value_names = ["MIN", "MAX"], allow_hyphen_values = true)]
     pub depth: Option<Vec<OsString>>,
+    #[command(flatten)]
+    pub secondary: super::render::SecondaryArgs,
 }
 
 pub fn run_inspect(a: &InspectArgs) -> anyhow::Result<()> {
@@ -73,12 +75,15 @@ pub fn run_inspect(a: &InspectArgs) -> anyhow::Result<()> {
         Some(_) => return Err(usage("--depth needs MIN MAX")),
         None => None,
     };
+    let secondary = a.secondary.secondary()?;
     let scene = load_scene(a.scene.as_deref())?;
     let compiled = CompiledScene::new(&scene);
+    secondary.check_bounded(&compiled).map_err(usage)?;
     let settings = RenderSettings {
         shade_back: a.shade_back,
         normal_transform: a.normal_transform.into(),
         object_rays: a.object_rays.into(),
+        secondary,
         ..RenderSettings::new(w, h)
     };
     let story = inspect_pixel(&scene, &compiled, &settings, x, row);

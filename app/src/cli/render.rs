@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use clap::ValueEnum;
-use tracelab_core::render::{RenderPlan, SharedFrame, Uncancellable, render};
+use tracelab_core::render::{RenderPlan, Secondary, SharedFrame, Uncancellable, render};
 use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
 use super::progress::Progress;
@@ -41,6 +41,50 @@ pub struct RenderArgs {
     /// How rays go into object space, and which t is kept as the depth.
     #[arg(long, value_enum, default_value_t = ObjectRaysMode::Unnormalized)]
     pub object_rays: ObjectRaysMode,
+    #[command(flatten)]
+    pub secondary: SecondaryArgs,
+}
+
+/// Assignments 3–4's flags, shared by `render` and `inspect`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SecondaryArgs {
+    /// Shadow rays toward every light (the course's -shadows).
+    #[arg(long)]
+    pub shadows: bool,
+    /// Levels of reflected and refracted rays (the course's -bounces; 0 to 100).
+    #[arg(long, default_value_t = 0)]
+    pub bounces: u32,
+    /// Rays whose weight is below this are not traced (the course's -weight).
+    #[arg(long, default_value_t = 0.0)]
+    pub weight: f32,
+    /// Assignment 3's optional fix: highlights fade with max(N·L, 0) instead of stopping.
+    #[arg(long)]
+    pub specular_fix: bool,
+}
+
+impl SecondaryArgs {
+    /// The secondary-ray settings, checked as the course form checks them.
+    pub fn secondary(&self) -> anyhow::Result<Secondary> {
+        if self.bounces > super::course::MAX_BOUNCES {
+            return Err(usage(format!(
+                "--bounces: at most {} levels, found {}",
+                super::course::MAX_BOUNCES,
+                self.bounces
+            )));
+        }
+        if !(self.weight.is_finite() && self.weight >= 0.0) {
+            return Err(usage(format!(
+                "--weight: expected a number of 0 or more, found {}",
+                self.weight
+            )));
+        }
+        Ok(Secondary {
+            shadows: self.shadows,
+            bounces: self.bounces,
+            weight: self.weight,
+            specular_fix: self.specular_fix,
+        })
+    }
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,6 +136,8 @@ pub struct RenderJob {
     pub shade_back: bool,
     pub normal_transform: NormalTransform,
     pub object_rays: ObjectRays,
+    /// Shadows, bounces, weight and the specular fix (assignments 3–4).
+    pub secondary: Secondary,
 }
 
 pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
@@ -108,6 +154,7 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
             ))
         }
     };
+    let secondary = r.secondary.secondary()?;
     let job = RenderJob {
         scene: r.scene,
         width: r.size.first().copied().unwrap_or(0),
@@ -118,6 +165,7 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
         shade_back: r.shade_back,
         normal_transform: r.normal_transform.into(),
         object_rays: r.object_rays.into(),
+        secondary,
     };
     if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
         return Err(usage(
@@ -180,6 +228,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         normal_transform: job.normal_transform,
         object_rays: job.object_rays,
         variant: None,
+        secondary: job.secondary,
     };
     let frame = render_with_progress(&compiled, &settings)?;
     let save = |view: View, depth: (f32, f32), path: &Path| {
@@ -227,6 +276,8 @@ pub(super) fn render_with_progress(
     scene: &CompiledScene,
     settings: &RenderSettings,
 ) -> anyhow::Result<tracelab_core::Frame> {
+    // Rays that double at every bounce would never finish: refused before any work.
+    settings.secondary.check_bounded(scene).map_err(usage)?;
     let target = Arc::new(
         SharedFrame::try_sized(settings.width, settings.height)
             .map_err(|_| out_of_memory(settings.width, settings.height))?,

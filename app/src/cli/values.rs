@@ -16,6 +16,19 @@ pub(super) fn parse_f32(s: &OsStr, what: &str) -> anyhow::Result<f32> {
         })
 }
 
+/// A whole number of 0 or more (`-bounces 0`), spelled as the course's `atoi` reads one
+/// that is valid: digits only.
+pub(super) fn parse_count(s: &OsStr, what: &str) -> anyhow::Result<u32> {
+    s.to_str()
+        .and_then(|t| t.parse::<u32>().ok())
+        .ok_or_else(|| {
+            usage(format!(
+                "{what}: expected a whole number of 0 or more, found \"{}\"",
+                s.display()
+            ))
+        })
+}
+
 pub(super) fn parse_u32(s: &OsStr, what: &str) -> anyhow::Result<u32> {
     s.to_str()
         .and_then(|t| t.parse::<u32>().ok())

@@ -58,6 +58,8 @@ pub enum AppCommand {
     ShowPixelInspector(bool),
     /// The Ray panel's diagrams beside the pixel inspector's story.
     ShowRayPanel(bool),
+    /// Shadows, bounces, weight and the specular fix of the view (View › Rays).
+    SetRays(tracelab_core::render::Secondary),
     ResetLayout,
     /// Move the camera to show the selected node whole (F).
     FrameSelected,

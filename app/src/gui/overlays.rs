@@ -96,7 +96,8 @@ pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
 /// right corner, in the light's colour.
 pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scene: &Scene) {
     for (i, l) in scene.lights().iter().enumerate() {
-        let Some(d) = tracelab_core::scene::unit(l.direction) else {
+        // A point light has no one direction (its place is for the gizmo to show).
+        let Some(d) = l.direction().and_then(tracelab_core::scene::unit) else {
             continue;
         };
         let c = l.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;

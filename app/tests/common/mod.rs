@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 // The one reader of the data settings (TRACELAB_COURSE_DIR, …), shared with core's tests.
 #[path = "../../../core/tests/common/data.rs"]
 mod data;
-pub use data::{course_dir, meshes_dir, perf_dir};
+pub use data::{course_dir, meshes_dir, perf_dir, semester_dir};
 
 /// The repository's root (scenes/, assets/).
 pub fn repo() -> PathBuf {

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use super::MAX_SCENE_BYTES;
 use crate::scene::{
-    Anchor, Camera, Comments, Graph, MaterialKeyword, NodeId, NodeKind, Problem, Scene,
+    Anchor, Camera, Comments, Graph, LightKind, MaterialKeyword, NodeId, NodeKind, Problem, Scene,
     TransformOp, check_scene,
 };
 
@@ -126,12 +126,29 @@ pub fn write_scene(scene: &Scene) -> String {
         let in2 = format!("{IND}{IND}");
         for l in lights {
             comment_lines(&mut out, IND, &l.comments.before);
-            let _ = writeln!(out, "{IND}DirectionalLight {{");
+            let _ = writeln!(out, "{IND}{} {{", l.keyword());
             let mut li = Inner::new(&l.comments);
-            li.field(&mut out, &in2, "direction");
-            let _ = writeln!(out, "{in2}direction {}", v3(l.direction));
-            li.field(&mut out, &in2, "color");
-            let _ = writeln!(out, "{in2}color {}", v3(l.color));
+            match l.kind {
+                LightKind::Directional { direction } => {
+                    li.field(&mut out, &in2, "direction");
+                    let _ = writeln!(out, "{in2}direction {}", v3(direction));
+                    li.field(&mut out, &in2, "color");
+                    let _ = writeln!(out, "{in2}color {}", v3(l.color));
+                }
+                LightKind::Point {
+                    position,
+                    attenuation,
+                } => {
+                    li.field(&mut out, &in2, "position");
+                    let _ = writeln!(out, "{in2}position {}", v3(position));
+                    li.field(&mut out, &in2, "color");
+                    let _ = writeln!(out, "{in2}color {}", v3(l.color));
+                    if let Some(a) = attenuation {
+                        li.field(&mut out, &in2, "attenuation");
+                        let _ = writeln!(out, "{in2}attenuation {}", v3(a));
+                    }
+                }
+            }
             li.finish(&mut out, &in2, &l.comments.end);
             let _ = writeln!(out, "{IND}}}");
         }
@@ -463,7 +480,9 @@ mod tests {
         assert_eq!(try_write_scene(&scene), Ok(write_scene(&scene)));
         let mut bad = scene.clone();
         if let Some(l) = bad.lights.as_mut().and_then(|l| l.first_mut()) {
-            l.direction = Vec3::ZERO;
+            l.kind = LightKind::Directional {
+                direction: Vec3::ZERO,
+            };
         }
         let p = try_write_scene(&bad).expect_err("a zero light direction");
         assert_eq!(p.len(), 1);

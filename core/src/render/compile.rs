@@ -16,7 +16,19 @@ use crate::geometry::{
     intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
 };
 use crate::memory::{OutOfMemory, try_with_capacity};
-use crate::scene::{DEFAULT_MATERIAL_COLOR, Mesh, MeshSlot, NodeId, NodeKind, Scene, Walk, unit};
+use crate::scene::{
+    DEFAULT_ATTENUATION, DEFAULT_MATERIAL_COLOR, LightKind, Mesh, MeshSlot, NodeId, NodeKind,
+    Phong, Scene, Walk, unit,
+};
+
+/// A point light ready to shade with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub color: Vec3,
+    /// (constant, linear, quadratic): the colour is divided by c + l·d + q·d².
+    pub attenuation: Vec3,
+}
 
 #[derive(Clone, Debug)]
 pub enum Shape {
@@ -68,9 +80,18 @@ pub struct CompiledScene {
     pub camera: CameraRays,
     pub background: Vec3,
     pub ambient: Vec3,
-    /// (direction toward the light, normalised; colour)
+    /// The directional lights: (direction toward the light, normalised; colour).
     pub lights: Vec<(Vec3, Vec3)>,
+    /// The point lights (assignment 4), shaded by `whitted.rs` only.
+    pub point_lights: Vec<PointLight>,
+    /// The scene's index of each light of `lights`, then of each of `point_lights`.
+    light_indices: Vec<usize>,
+    /// Each material's diffuse colour (the last entry is the default material).
     pub materials: Vec<Vec3>,
+    /// Each material's Phong terms, parallel to `materials`.
+    pub phong: Vec<Phong>,
+    /// Some material has a highlight, a mirror or glass: colour needs `whitted.rs`.
+    pub(super) has_phong_terms: bool,
     pub objects: Vec<Object>,
     pub(super) bvh: Bvh,
     /// Objects with no finite bounds (planes), tested for every ray.
@@ -191,17 +212,43 @@ impl CompiledScene {
             _ => None,
         };
 
-        let lights = scene
-            .lights()
-            .iter()
-            .map(|l| (-unit(l.direction).unwrap_or(Vec3::NEG_Z), l.color))
-            .collect();
+        let mut lights = Vec::new();
+        let mut point_lights = Vec::new();
+        let (mut directional_at, mut point_at) = (Vec::new(), Vec::new());
+        for (i, l) in scene.lights().iter().enumerate() {
+            match l.kind {
+                LightKind::Directional { direction } => {
+                    directional_at.push(i);
+                    lights.push((-unit(direction).unwrap_or(Vec3::NEG_Z), l.color))
+                }
+                LightKind::Point {
+                    position,
+                    attenuation,
+                } => {
+                    point_at.push(i);
+                    point_lights.push(PointLight {
+                        position,
+                        color: l.color,
+                        attenuation: attenuation.unwrap_or(DEFAULT_ATTENUATION),
+                    })
+                }
+            }
+        }
+        directional_at.extend(point_at);
+        let light_indices = directional_at;
+        let mut phong: Vec<Phong> = scene.materials.iter().map(|m| m.phong()).collect();
+        phong.push(Phong::default());
+        let has_phong_terms = phong.iter().any(|p| !p.is_diffuse_only());
         Ok(CompiledScene {
             camera: CameraRays::new(&scene.camera),
             background: scene.background_color(),
             ambient: scene.effective_ambient(),
             lights,
+            point_lights,
+            light_indices,
             materials,
+            phong,
+            has_phong_terms,
             objects,
             bvh,
             unbounded,
@@ -476,6 +523,19 @@ impl CompiledScene {
             Some(o) => o.material,
             None => self.default_material(),
         }
+    }
+
+    /// The scene's index (in its Lights block) of light `k` of `lights` then `point_lights`.
+    pub fn light_index(&self, k: usize) -> usize {
+        self.light_indices.get(k).copied().unwrap_or(k)
+    }
+
+    /// The Phong terms of the material `hit_material` names.
+    pub fn hit_phong(&self, hit: &Hit) -> Phong {
+        self.phong
+            .get(self.hit_material(hit) as usize)
+            .copied()
+            .unwrap_or_default()
     }
 
     /// The colour `hit_material` names.

@@ -64,6 +64,9 @@ pub struct RayStory {
     pub hit: Option<HitStory>,
     pub background: Vec3,
     pub normal_transform: NormalTransform,
+    /// The eye ray's tree of shadow, reflected and refracted rays, where the scene or the
+    /// settings need more than the lecture's diffuse shading (assignments 3–4).
+    pub ray_tree: Option<super::whitted::RayNode>,
 }
 
 impl RayStory {
@@ -144,6 +147,9 @@ pub fn inspect_pixel(
                 shade: story_shade(compiled, &world_ray, &hit, settings),
             })
         });
+    // Assignments 3–4: every shadow, reflected and refracted ray behind the pixel.
+    let ray_tree = super::whitted::needs_whitted(compiled, settings)
+        .then(|| super::whitted::ray_tree(compiled, &world_ray, settings));
     RayStory {
         x,
         row,
@@ -151,6 +157,7 @@ pub fn inspect_pixel(
         hit,
         background: compiled.background,
         normal_transform: settings.normal_transform,
+        ray_tree,
     }
 }
 

@@ -16,9 +16,10 @@ mod rule_gap;
 mod shade;
 mod shade_lanes;
 mod similitude;
+mod whitted;
 
 pub use camera::CameraRays;
-pub use compile::{CompiledScene, Hit, Object, Shape};
+pub use compile::{CompiledScene, Hit, Object, PointLight, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
@@ -29,6 +30,10 @@ pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_fr
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
+pub use whitted::{
+    Blocker, Cut, LightShare, MAX_SECONDARY_RAYS, RayKind, RayNode, SECONDARY_T_MIN, Secondary,
+    ShadowRay, needs_whitted, ray_tree, transmitted,
+};
 
 /// How world normals are obtained from object-space ones under a Transform.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -68,6 +73,8 @@ pub struct RenderSettings {
     /// A known student mistake (or two) to render instead of the course's image, for
     /// `tracelab diff`'s diagnosis; `None` is the course's render.
     pub variant: Option<Variant>,
+    /// Shadows, reflection and refraction (assignment 4) and the specular fix (assignment 3).
+    pub secondary: Secondary,
 }
 
 impl RenderSettings {
@@ -79,6 +86,7 @@ impl RenderSettings {
             normal_transform: NormalTransform::Correct,
             object_rays: ObjectRays::Unnormalized,
             variant: None,
+            secondary: Secondary::default(),
         }
     }
 }

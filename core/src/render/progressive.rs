@@ -20,6 +20,7 @@ use super::frame::{Frame, Sample, write_sample};
 use super::plan::{Cancel, RenderPlan, Schedule, Tracing, Uncancellable};
 use super::shade::shade_fast;
 use super::shade_lanes::shade_packet;
+use super::whitted::{needs_whitted, shade_primary};
 use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
@@ -105,10 +106,15 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut S
     } else {
         scene.intersect_with(&ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
     };
+    let whitted = needs_whitted(scene, s);
     let shaded = hit
         .as_ref()
         .map_or((glam::Vec3::ZERO, glam::Vec3::ZERO), |h| {
-            shade_fast(scene, &ray, h, s)
+            if whitted {
+                shade_primary(scene, &ray, h, s)
+            } else {
+                shade_fast(scene, &ray, h, s)
+            }
         });
     store_sample(scene, dst, hit.as_ref(), shaded);
 }
@@ -125,6 +131,7 @@ fn trace_packets(
     grid: &mut [Sample],
 ) {
     let t_min = scene.camera.t_min();
+    let whitted = needs_whitted(scene, s);
     // Every miss stores the same sample: quantise the background once, not per pixel.
     let mut miss = Sample::UNSET;
     store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
@@ -142,7 +149,18 @@ fn trace_packets(
             f32::INFINITY,
             pass.scale >= SPARSE_FROM_SCALE,
         );
-        let shaded = shade_packet(scene, &r, &hits, s);
+        let shaded = if whitted {
+            // Secondary rays go one by one from each lane's hit.
+            std::array::from_fn(|k| {
+                hits[k]
+                    .as_ref()
+                    .map_or((glam::Vec3::ZERO, glam::Vec3::ZERO), |h| {
+                        shade_primary(scene, &r[k], h, s)
+                    })
+            })
+        } else {
+            shade_packet(scene, &r, &hits, s)
+        };
         for (k, &(i, j)) in chunk.iter().enumerate() {
             let dst = &mut grid[pass.index(i, j)];
             match &hits[k] {

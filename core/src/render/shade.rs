@@ -70,6 +70,10 @@ pub fn shade_hit(
         });
     }
     info.color = c;
+    if super::whitted::needs_whitted(scene, settings) {
+        // Highlights, point lights, shadows and bounces: the colour the render gives.
+        info.color = super::whitted::shade_primary(scene, ray, hit, settings).0;
+    }
     info
 }
 

@@ -5,6 +5,7 @@
 mod comments;
 mod graph;
 mod mesh;
+mod phong;
 mod transform;
 pub mod validate;
 pub mod walk;
@@ -13,6 +14,7 @@ pub mod words;
 pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
+pub use phong::{PHONG_FIELDS, Phong, PhongField, phong_field};
 pub use transform::{TransformOp, compose, compose_f64, op_matrix_f64, unit};
 pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene};
 pub use walk::{Visit, Walk};
@@ -67,20 +69,65 @@ impl Camera {
     }
 }
 
-/// A directional light: `direction` points from the light into the scene.
+/// Where a light's light comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// `DirectionalLight`: `direction` points from the light into the scene.
+    Directional { direction: Vec3 },
+    /// `PointLight` (assignment 4): the colour reaching a point at distance d is
+    /// colour / (c + l·d + q·d²) with `attenuation` = (c, l, q); absent in the file means the
+    /// course's (1, 0, 0), kept absent so a round trip writes the same text.
+    Point {
+        position: Vec3,
+        attenuation: Option<Vec3>,
+    },
+}
+
+/// The course's default point-light attenuation: constant 1, no fall-off.
+pub const DEFAULT_ATTENUATION: Vec3 = Vec3::new(1.0, 0.0, 0.0);
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
-    pub direction: Vec3,
+    pub kind: LightKind,
     pub color: Vec3,
     pub comments: Comments,
 }
 
 impl Light {
+    /// A directional light.
     pub fn new(direction: Vec3, color: Vec3) -> Self {
         Light {
-            direction,
+            kind: LightKind::Directional { direction },
             color,
             comments: Comments::default(),
+        }
+    }
+
+    /// A point light with the attenuation the file gives (None: the course's default).
+    pub fn point(position: Vec3, color: Vec3, attenuation: Option<Vec3>) -> Self {
+        Light {
+            kind: LightKind::Point {
+                position,
+                attenuation,
+            },
+            color,
+            comments: Comments::default(),
+        }
+    }
+
+    /// The direction of a directional light (None for a point light).
+    pub fn direction(&self) -> Option<Vec3> {
+        match self.kind {
+            LightKind::Directional { direction } => Some(direction),
+            LightKind::Point { .. } => None,
+        }
+    }
+
+    /// The file's keyword for this light.
+    pub fn keyword(&self) -> &'static str {
+        match self.kind {
+            LightKind::Directional { .. } => "DirectionalLight",
+            LightKind::Point { .. } => "PointLight",
         }
     }
 }
@@ -105,7 +152,10 @@ pub enum MaterialKeyword {
 pub struct Material {
     pub diffuse: Vec3,
     pub keyword: MaterialKeyword,
-    /// Fields tracelab does not shade with (specularColor, exponent, ...), kept for the writer.
+    /// Every field but diffuseColor, in the file's order, for the writer: the course's
+    /// Phong fields (`phong.rs`: specularColor, exponent, reflectiveColor, transparentColor,
+    /// indexOfRefraction), read through [`Material::phong`], and any other name, which the
+    /// reader warns about by name and the renderer does not use.
     pub extra: Vec<(String, Vec<f32>)>,
     pub comments: Comments,
 }

@@ -7,7 +7,9 @@ use glam::{DMat3, DMat4, Vec3};
 use super::transform::{compose_f64, op_matrix_f64, unit};
 use super::walk::Walk;
 use super::words::{is_numberlike, is_word};
-use super::{Background, Camera, Graph, Light, Material, NodeId, NodeKind, Scene, TransformOp};
+use super::{
+    Background, Camera, Graph, Light, LightKind, Material, NodeId, NodeKind, Scene, TransformOp,
+};
 
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
 #[derive(Clone, Debug, PartialEq)]
@@ -160,13 +162,38 @@ pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
 }
 
 pub fn check_light(l: &Light) -> Result<(), Invalid> {
-    finite3("direction", l.direction)?;
-    finite3("color", l.color)?;
-    if unit(l.direction).is_none() {
-        return Err(Invalid::new(
-            "direction",
-            "DirectionalLight: direction must not be zero",
-        ));
+    match l.kind {
+        LightKind::Directional { direction } => {
+            finite3("direction", direction)?;
+            finite3("color", l.color)?;
+            if unit(direction).is_none() {
+                return Err(Invalid::new(
+                    "direction",
+                    "DirectionalLight: direction must not be zero",
+                ));
+            }
+        }
+        LightKind::Point {
+            position,
+            attenuation,
+        } => {
+            finite3("position", position)?;
+            finite3("color", l.color)?;
+            if let Some(a) = attenuation {
+                finite3("attenuation", a)?;
+                // c + l·d + q·d² must stay positive for every distance d > 0.
+                if a.min_element() < 0.0 || a == Vec3::ZERO {
+                    return Err(Invalid::new(
+                        "attenuation",
+                        format!(
+                            "PointLight: attenuation (constant, linear, quadratic) must be \
+                             non-negative and not all zero, found {} {} {}",
+                            a.x, a.y, a.z
+                        ),
+                    ));
+                }
+            }
+        }
     }
     Ok(())
 }
@@ -201,8 +228,35 @@ pub fn check_material(m: &Material) -> Result<(), Invalid> {
             ));
         }
         finite(name, values)?;
+        check_phong_field(name, values)?;
     }
     Ok(())
+}
+
+/// A Phong field's count of numbers and range; other names pass (the reader warns of them).
+fn check_phong_field(name: &str, values: &[f32]) -> Result<(), Invalid> {
+    let Some(f) = super::phong::phong_field(name) else {
+        return Ok(());
+    };
+    if values.len() != f.numbers {
+        let m = format!(
+            "\"{name}\" takes {} number(s), found {}",
+            f.numbers,
+            values.len()
+        );
+        return Err(Invalid::new(name, m));
+    }
+    match (name, values) {
+        ("exponent", &[e]) if e < 0.0 => Err(Invalid::new(
+            name,
+            format!("exponent must not be negative, found {e}"),
+        )),
+        ("indexOfRefraction", &[n]) if n <= 0.0 => Err(Invalid::new(
+            name,
+            format!("indexOfRefraction must be positive, found {n}"),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Why a linear map cannot move rays into object space, if it cannot: zero or overflowing

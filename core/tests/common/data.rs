@@ -6,6 +6,7 @@
 //! | `TRACELAB_COURSE_DIR` | `../shared/mit6837` | the course's scenes, `commands.txt`, reference images |
 //! | `TRACELAB_MESHES_DIR` | `../shared/meshes` | scanned meshes (cube, bunnies, dragon) |
 //! | `TRACELAB_PERF_DIR` | `../shared/perf` | the benchmark scenes (`bench_*.txt`) |
+//! | `TRACELAB_SEMESTER_DIR` | `../shared/mit6837-semester` | assignments 3–7: scenes, `commands.txt`, reference images |
 //!
 //! A relative value is taken from the workspace root, whatever folder cargo runs the test in.
 //! Tests that read one are `#[ignore = "needs …"]`: a plain `cargo test` lists them as
@@ -41,6 +42,15 @@ pub fn perf_dir() -> PathBuf {
         "TRACELAB_PERF_DIR",
         "../shared/perf",
         "the benchmark scenes (bench_*.txt)",
+    )
+}
+
+/// The course's later weeks (assignments 3–7): `scenes/`, `commands.txt`, `reference/`.
+pub fn semester_dir() -> PathBuf {
+    required(
+        "TRACELAB_SEMESTER_DIR",
+        "../shared/mit6837-semester",
+        "the course's assignment 3-7 files (scenes, commands.txt, reference images)",
     )
 }
 

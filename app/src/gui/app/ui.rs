@@ -135,6 +135,14 @@ impl TracelabApp {
             {
                 ui.close();
             }
+            ui.separator();
+            ui.menu_button("Rays (assignments 3–4)", |ui| {
+                let mut rays = self.view.secondary;
+                rays_menu(ui, &mut rays);
+                if rays != self.view.secondary {
+                    out.push(AppCommand::SetRays(rays));
+                }
+            });
         });
     }
 
@@ -376,4 +384,19 @@ impl TracelabApp {
             ctx.request_repaint_after(file_watch::POLL_EVERY);
         }
     }
+}
+
+/// The course's `-shadows`, `-bounces` and `-weight`, and assignment 3's optional fix: off,
+/// 0 and 0 as the course's `raytracer` starts. The coarse passes trace what the full pass
+/// traces (the same bounces), so a preview never shows a different image.
+fn rays_menu(ui: &mut egui::Ui, s: &mut tracelab_core::render::Secondary) {
+    ui.checkbox(&mut s.shadows, "Shadows (-shadows)");
+    ui.add(egui::Slider::new(&mut s.bounces, 0..=10).text("bounces (-bounces)"));
+    ui.add(
+        egui::Slider::new(&mut s.weight, 0.0..=1.0)
+            .text("weight cut-off (-weight)")
+            .step_by(0.01),
+    );
+    ui.checkbox(&mut s.specular_fix, "Specular fix (optional, assignment 3)")
+        .on_hover_text("The highlight fades with max(N·L, 0) instead of stopping where N·L ≤ 0");
 }

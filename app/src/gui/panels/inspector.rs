@@ -3,6 +3,7 @@
 //! nothing here changes the document or reads files.
 
 use glam::{Mat4, Vec3};
+use tracelab_core::scene::{DEFAULT_ATTENUATION, LightKind};
 use tracelab_core::{
     Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
 };
@@ -43,12 +44,21 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
                     ui.separator();
                     light(ui, doc, i, &mut edits);
                 }
-                if ui.button("Add light").clicked() {
-                    edits.push(Edit::AddLight(Light::new(
-                        Vec3::new(-0.5, -1.0, -0.5),
-                        Vec3::splat(0.5),
-                    )));
-                }
+                ui.horizontal(|ui| {
+                    if ui.button("Add light").clicked() {
+                        edits.push(Edit::AddLight(Light::new(
+                            Vec3::new(-0.5, -1.0, -0.5),
+                            Vec3::splat(0.5),
+                        )));
+                    }
+                    if ui.button("Add point light").clicked() {
+                        edits.push(Edit::AddLight(Light::point(
+                            Vec3::new(0.0, 5.0, 5.0),
+                            Vec3::splat(0.5),
+                            None,
+                        )));
+                    }
+                });
             }
             Some(Selection::Light(i)) => light(ui, doc, i, &mut edits),
             Some(Selection::Background) => background(ui, &doc.scene.background, &mut edits),
@@ -264,8 +274,32 @@ fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
     };
     let mut l = l.clone();
     show_refusal_for(ui, doc, Some(Place::Light(i)));
-    ui.strong(format!("Light {i} (directional)"));
-    let mut changed = vec3(ui, "direction", &mut l.direction, 0.01);
+    let mut changed = match &mut l.kind {
+        LightKind::Directional { direction } => {
+            ui.strong(format!("Light {i} (directional)"));
+            vec3(ui, "direction", direction, 0.01)
+        }
+        LightKind::Point {
+            position,
+            attenuation,
+        } => {
+            ui.strong(format!("Light {i} (point)"));
+            let mut changed = vec3(ui, "position", position, 0.01);
+            // Absent means the course's 1 0 0, and stays absent until given.
+            let mut on = attenuation.is_some();
+            if ui
+                .checkbox(&mut on, "attenuation (constant, linear, quadratic)")
+                .changed()
+            {
+                *attenuation = on.then_some(DEFAULT_ATTENUATION);
+                changed = true;
+            }
+            if let Some(a) = attenuation {
+                changed |= vec3(ui, "attenuation", a, 0.01);
+            }
+            changed
+        }
+    };
     changed |= color(ui, "colour", &mut l.color);
     if changed {
         edits.push(Edit::SetLight { index: i, light: l });

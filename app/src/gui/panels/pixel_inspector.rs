@@ -128,6 +128,7 @@ pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
         hit,
         background,
         normal_transform,
+        ray_tree,
     } = story;
     ui.label(format!("Pixel ({x}, {row}), rows from the top"));
     ui.label(format!(
@@ -205,4 +206,18 @@ pub fn ui(ui: &mut egui::Ui, story: &RayStory, scene: &Scene) {
         }
         row("colour (sum)", a(h.shading.color));
     });
+    if let Some(tree) = ray_tree {
+        ray_tree_ui(ui, tree);
+    }
+}
+
+/// Assignments 3–4: the pixel's ray tree, one ray a block, indented by level.
+fn ray_tree_ui(ui: &mut egui::Ui, tree: &tracelab_core::render::RayNode) {
+    ui.separator();
+    ui.strong(format!("Ray tree ({} rays)", tree.count()));
+    let mut lines = Vec::new();
+    crate::story::ray_tree_lines(&crate::story::ray_tree_report(tree), 0, &mut lines);
+    for l in lines {
+        ui.label(egui::RichText::new(l).monospace());
+    }
 }

@@ -2,7 +2,7 @@
 //! range and size controls, the images themselves (uploaded as textures when the worker has
 //! new pixels), and picking.
 
-use tracelab_core::render::{MAX_IMAGE_SIDE, NormalGap, check_image_size};
+use tracelab_core::render::{MAX_IMAGE_SIDE, NormalGap, Secondary, check_image_size};
 use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
 
 use crate::document::{Document, Selection};
@@ -48,6 +48,8 @@ pub struct ViewSettings {
     pub gizmo_axes: Axes,
     /// Draw the gizmo and the overlays (outline, axes, lights).
     pub overlays: bool,
+    /// Shadows, bounces, weight and the specular fix (View › Rays); the course's defaults.
+    pub secondary: Secondary,
 }
 
 impl Default for ViewSettings {
@@ -63,6 +65,7 @@ impl Default for ViewSettings {
             split: 0.5,
             gizmo_axes: Axes::World,
             overlays: true,
+            secondary: Secondary::default(),
         }
     }
 }
@@ -609,6 +612,7 @@ impl Viewport {
             normal_transform: s.normal_transform,
             object_rays: s.object_rays,
             variant: None,
+            secondary: s.secondary,
         }
     }
 }

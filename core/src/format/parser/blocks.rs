@@ -4,8 +4,9 @@ use super::super::lexer::TokKind;
 use super::Parser;
 use super::fields::block_comments;
 use super::objects::OBJECT_KEYWORDS;
+use crate::scene::phong_field;
 use crate::scene::{
-    Anchor, Background, Camera, Comments, Light, Material, MaterialKeyword, validate,
+    Anchor, Background, Camera, Comments, Light, LightKind, Material, MaterialKeyword, validate,
 };
 
 impl Parser<'_> {
@@ -124,12 +125,12 @@ impl Parser<'_> {
             block: "Lights",
             count: "numLights",
             noun: "light",
-            expected: "numLights or DirectionalLight",
+            expected: "numLights, DirectionalLight or PointLight",
         };
         let second = self.lights.is_some();
         let read = self.read_list_block(&list, off, second, |this, kw, at| match kw {
-            "DirectionalLight" => {
-                if let Some(light) = this.parse_directional_light(at) {
+            "DirectionalLight" | "PointLight" => {
+                if let Some(light) = this.parse_light(kw, at) {
                     lights.push(light);
                 }
                 true
@@ -144,22 +145,45 @@ impl Parser<'_> {
         self.lights = Some(lights);
     }
 
-    fn parse_directional_light(&mut self, off: usize) -> Option<Light> {
-        let kw = "DirectionalLight";
+    /// `DirectionalLight { direction color }` or `PointLight { position color
+    /// [attenuation] }` (assignment 4; attenuation defaults to the course's 1 0 0).
+    fn parse_light(&mut self, kw: &str, off: usize) -> Option<Light> {
         let before = self.comments_here();
         let open = self.expect_open(kw)?;
         let (mut f, end) = self.read_fields(kw, open)?;
         let comments = block_comments(before, &mut f, end);
-        let d = self.take_vec3(&mut f, kw, off, "direction");
-        let c = self.take_vec3(&mut f, kw, off, "color");
-        self.reject_unused(&f, kw, "direction, color");
+        let kind = if kw == "PointLight" {
+            let p = self.take_vec3(&mut f, kw, off, "position");
+            let c = self.take_vec3(&mut f, kw, off, "color");
+            let mut attenuation = None;
+            if f.iter().any(|x| x.name == "attenuation") {
+                attenuation = Some(self.take_vec3(&mut f, kw, off, "attenuation"));
+            }
+            self.reject_unused(&f, kw, "position, color, attenuation");
+            let attenuation = match attenuation {
+                Some(a) => Some(a?),
+                None => None,
+            };
+            (
+                LightKind::Point {
+                    position: p?,
+                    attenuation,
+                },
+                c?,
+            )
+        } else {
+            let d = self.take_vec3(&mut f, kw, off, "direction");
+            let c = self.take_vec3(&mut f, kw, off, "color");
+            self.reject_unused(&f, kw, "direction, color");
+            (LightKind::Directional { direction: d? }, c?)
+        };
         let light = Light {
-            direction: d?,
-            color: c?,
+            kind: kind.0,
+            color: kind.1,
             comments,
         };
         if let Err(e) = validate::check_light(&light) {
-            self.error(off, e.message);
+            self.error(self.field_offset(&f, &e.field).unwrap_or(off), e.message);
         }
         Some(light)
     }
@@ -184,6 +208,41 @@ impl Parser<'_> {
             self.error(x.name_off, msg);
             ok = false;
         }
+        for x in &f {
+            match phong_field(&x.name) {
+                Some(p) if x.values.len() != p.numbers => {
+                    let msg = format!(
+                        "\"{}\" takes {} number(s), found {}",
+                        x.name,
+                        p.numbers,
+                        x.values.len()
+                    );
+                    self.error(x.name_off, msg);
+                    ok = false;
+                }
+                Some(_) => {}
+                None if x.name == "diffuseColor" => {}
+                None if x.values.is_empty() => {
+                    let msg = format!(
+                        "\"{}\" has no numbers: a material field is a name and its numbers \
+                         (expected diffuseColor, specularColor, exponent, reflectiveColor, \
+                         transparentColor or indexOfRefraction)",
+                        x.name
+                    );
+                    self.error(x.name_off, msg);
+                    ok = false;
+                }
+                None => self.warn(
+                    x.name_off,
+                    format!(
+                        "\"{}\" is not a field tracelab renders (a material has diffuseColor, \
+                         specularColor, exponent, reflectiveColor, transparentColor, \
+                         indexOfRefraction); kept and written back, not used",
+                        x.name
+                    ),
+                ),
+            }
+        }
         if !ok {
             return None;
         }
@@ -192,19 +251,25 @@ impl Parser<'_> {
         } else {
             MaterialKeyword::Material
         };
-        // Other fields (specularColor, exponent, …) are kept, not shaded with.
+        // The Phong fields and any others, in the file's order (`Material::phong` reads them).
         let extra = f
             .iter()
             .filter(|x| !x.used)
             .map(|x| (x.name.clone(), x.values.iter().map(|v| v.0).collect()))
             .collect();
         let comments = block_comments(before, &mut f, end);
-        Some(Material {
+        let m = Material {
             diffuse,
             keyword,
             extra,
             comments,
-        })
+        };
+        // Ranges (a negative exponent, an index of refraction ≤ 0), at the field at fault.
+        if let Err(e) = validate::check_material(&m) {
+            self.error(self.field_offset(&f, &e.field).unwrap_or(off), e.message);
+            return None;
+        }
+        Some(m)
     }
 
     fn parse_materials(&mut self, off: usize) {

@@ -229,6 +229,11 @@ impl Parser<'_> {
         self.take(fields, block, off, name, 1).map(|v| v[0])
     }
 
+    /// Where field `name` of a block is written, to place a rule's message on it.
+    pub(super) fn field_offset(&self, fields: &[Field], name: &str) -> Option<usize> {
+        fields.iter().find(|f| f.name == name).map(|f| f.name_off)
+    }
+
     /// Reports fields nobody took (unknown or repeated names).
     pub(super) fn reject_unused(&mut self, fields: &[Field], block: &str, expected: &str) -> bool {
         let mut ok = true;
