@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 mod data;
-pub use data::{course_dir, meshes_dir, perf_dir};
+pub use data::{course_dir, meshes_dir, perf_dir, semester_dir};
 
 /// The repository's root (scenes/, assets/).
 pub fn repo() -> PathBuf {
