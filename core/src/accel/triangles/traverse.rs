@@ -1,5 +1,5 @@
 //! One ray through the tree: the closest hit (the SSE slab test anywhere, the AVX kernels
-//! where the CPU has them) and every hit (for CSG).
+//! where the CPU has them), whether there is any hit (shadow rays) and every hit (for CSG).
 
 use glam::{Vec3A, Vec4};
 
