@@ -195,6 +195,72 @@ impl Bvh {
         }
     }
 
+    /// Any-hit traversal: true as soon as `leaf(prim_id)` says true. It enters exactly the
+    /// boxes `traverse` enters while its t_max has not shrunk (the same slab test against the
+    /// same t_max), so it reaches every leaf `traverse` reaches before its first hit, and no
+    /// other: a leaf test that answers "is there a hit before t_max" gives `traverse`'s
+    /// "was anything hit" bit for bit.
+    #[inline]
+    pub fn any(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+        mut leaf: impl FnMut(u32) -> bool,
+    ) -> bool {
+        let Some(root) = self.nodes.first() else {
+            return false;
+        };
+        let (o, inv) = (Vec3A::from(origin), Vec3A::from(dir).recip());
+        if root.hit(o, inv, t_min, t_max).is_none() {
+            return false;
+        }
+        let mut stack = [0u32; MAX_DEPTH];
+        let mut sp = 0usize;
+        let mut idx = 0u32;
+        loop {
+            let node = &self.nodes[idx as usize];
+            if node.is_leaf() {
+                let first = node.right_or_first as usize;
+                let prims = self.indices.get(first..first + node.count as usize);
+                if prims.unwrap_or(&[]).iter().any(|&p| leaf(p)) {
+                    return true;
+                }
+            } else {
+                // Near child first, as `traverse`: the nearer objects are likelier blockers.
+                let (l, r) = (idx + 1, node.right_or_first);
+                let tl = self.nodes[l as usize].hit(o, inv, t_min, t_max);
+                let tr = self.nodes[r as usize].hit(o, inv, t_min, t_max);
+                let next = match (tl, tr) {
+                    (Some(a), Some(b)) => {
+                        let (near, far) = if a <= b { (l, r) } else { (r, l) };
+                        // Dropped when full, as in `traverse` (the depth cap keeps it from
+                        // filling).
+                        if sp < stack.len() {
+                            stack[sp] = far;
+                            sp += 1;
+                        }
+                        Some(near)
+                    }
+                    (Some(_), None) => Some(l),
+                    (None, Some(_)) => Some(r),
+                    (None, None) => None,
+                };
+                if let Some(n) = next {
+                    idx = n;
+                    continue;
+                }
+            }
+            // No re-test on pop: t_max never shrinks, so a pushed node still passes.
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            idx = stack[sp];
+        }
+    }
+
     /// `traverse` for eight rays together (lanes set in `active`), sharing one stack: each
     /// node's box is tested against every lane still in, near child first by the nearest
     /// lane's entry. `leaf(prim_id, lanes, t)` gets the lanes whose box test passed and the
@@ -486,6 +552,56 @@ mod tests {
             }
         }
         assert!(hits > 300, "{hits} hits");
+    }
+
+    #[test]
+    fn any_finds_a_hit_exactly_when_traverse_does() {
+        // The boxes as primitives, hit at their entry distance: for many rays and t ranges
+        // (cut at the closest hit and one ulp either side), `any` says whether `traverse`
+        // found anything, and visits no primitive `traverse` would not.
+        let b = boxes(3000);
+        let bvh = Bvh::build(&b);
+        let entry = |p: u32, o: Vec3, d: Vec3, t_min: f32, t_max: f32| {
+            let (near, far) = crate::accel::slab::span(
+                b[p as usize].min.into(),
+                b[p as usize].max.into(),
+                o.into(),
+                Vec3A::from(d).recip(),
+                t_min,
+                t_max,
+            );
+            (near <= far && near < t_max).then_some(near)
+        };
+        let mut s = 0x9e37_79b9u32;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s as f32 / u32::MAX as f32
+        };
+        let (mut compared, mut hits) = (0, 0);
+        for _ in 0..2000 {
+            let o = Vec3::new(rnd() * 12.0 - 1.0, rnd() * 12.0 - 1.0, rnd() * 12.0 - 1.0);
+            let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            let closest = |t_min: f32, t_max: f32| {
+                let t = bvh.traverse(o, d, t_min, t_max, |p, t| entry(p, o, d, t_min, t));
+                (t < t_max).then_some(t)
+            };
+            let first = closest(1e-3, f32::INFINITY);
+            let mut ranges = vec![(1e-3, f32::INFINITY)];
+            if let Some(t) = first {
+                ranges.extend([(1e-3, t), (1e-3, t.next_up()), (1e-3, t.next_down())]);
+                ranges.extend([(t, f32::INFINITY), (1e-3, t * 0.5)]);
+            }
+            for (lo, hi) in ranges {
+                let want = closest(lo, hi).is_some();
+                let got = bvh.any(o, d, lo, hi, |p| entry(p, o, d, lo, hi).is_some());
+                assert_eq!(got, want, "ray {o} {d} ({lo}, {hi})");
+                compared += 1;
+                hits += want as u32;
+            }
+        }
+        assert!(hits > 1000 && hits < compared, "{hits} of {compared}");
     }
 
     #[test]

@@ -99,7 +99,7 @@ pub struct CompiledScene {
     /// The one object of a scene that holds a single mesh and nothing else: rays go straight
     /// to it, since the mesh tests its own box first (in object space, needing no second
     /// reciprocal of the direction).
-    single_mesh: Option<u32>,
+    pub(super) single_mesh: Option<u32>,
 }
 
 impl CompiledScene {

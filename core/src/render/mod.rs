@@ -10,6 +10,7 @@ mod inspect;
 mod limits;
 pub mod mistakes;
 mod object_rays;
+mod occlusion;
 mod plan;
 mod progressive;
 mod rule_gap;

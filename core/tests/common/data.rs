@@ -4,6 +4,7 @@
 //! | variable | default | holds |
 //! |---|---|---|
 //! | `TRACELAB_COURSE_DIR` | `../shared/mit6837` | the course's scenes, `commands.txt`, reference images |
+//! | `TRACELAB_SEMESTER_DIR` | `../shared/mit6837-semester` | assignments 3–7: `scenes/` (with their meshes), `commands.txt`, references |
 //! | `TRACELAB_MESHES_DIR` | `../shared/meshes` | scanned meshes (cube, bunnies, dragon) |
 //! | `TRACELAB_PERF_DIR` | `../shared/perf` | the benchmark scenes (`bench_*.txt`) |
 //! | `TRACELAB_SEMESTER_DIR` | `../shared/mit6837-semester` | assignments 3–7: scenes, `commands.txt`, reference images |
@@ -24,6 +25,16 @@ pub fn course_dir() -> PathBuf {
         "TRACELAB_COURSE_DIR",
         "../shared/mit6837",
         "the course's files (scenes, commands.txt, reference images)",
+    )
+}
+
+/// The course's later assignments (3 to 7): `scenes/` with their meshes, `commands.txt`,
+/// `reference/`. Many of its scenes use features tracelab does not read (yet).
+pub fn semester_dir() -> PathBuf {
+    required(
+        "TRACELAB_SEMESTER_DIR",
+        "../shared/mit6837-semester",
+        "the course's assignment 3-7 files (scenes, commands.txt, reference images)",
     )
 }
 

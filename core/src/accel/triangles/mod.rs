@@ -5,7 +5,8 @@
 //! - `build`: the tree and the triangles' copies in leaf order.
 //! - `check`: the invariants (for tests) and the tree's shape (for `tracelab bench`).
 //! - `traverse`: one ray: the closest hit, with SSE anywhere and AVX where the CPU has it,
-//!   and every hit (for CSG).
+//!   whether there is any hit (the same walk, stopped at its first hit: shadow rays), and
+//!   every hit (for CSG).
 //! - `avx`: the AVX kernels (a ray against eight boxes, against a leaf's eight triangles);
 //!   their `unsafe` is only in `load8`, `store8` and `load_row`.
 //! - `packet`: eight coherent rays at once (`closest_hit8`, for `tracelab bench --packets`).

@@ -670,3 +670,133 @@ fn overflowing_triangles_give_the_same_hits_on_every_path() {
     }
     assert!(hits > 100, "{hits} hits");
 }
+
+/// The t ranges a shadow ray is asked about, for a ray whose closest hit from `t_min` on
+/// is `first`: unbounded, and when there is a hit, cut exactly at it (t_max is exclusive),
+/// one ulp either side, halfway, and from that hit on (the next crossing).
+fn shadow_ranges(first: Option<f32>, t_min: f32) -> Vec<(f32, f32)> {
+    let mut v = vec![(t_min, f32::INFINITY)];
+    if let Some(t) = first {
+        for t_max in [t, t.next_down(), t.next_up(), t * 0.5, t * 2.0] {
+            v.push((t_min, t_max));
+        }
+        v.extend([(t, f32::INFINITY), (t.next_down(), t.next_up())]);
+    }
+    v
+}
+
+/// `any_hit` answers `closest_hit(..).is_some()` for every range of `shadow_ranges`, on the
+/// path the CPU picks and on the SSE path. Returns (comparisons, of which true).
+fn assert_any_hit_agrees(bvh: &TriangleBvh, rays: &[Ray], t_min: f32) -> (usize, usize) {
+    let (mut compared, mut hit) = (0, 0);
+    for (k, ray) in rays.iter().enumerate() {
+        let (o, d) = (ray.origin.into(), ray.direction.into());
+        let first = bvh.closest_hit(o, d, t_min, f32::INFINITY).map(|h| h.t);
+        for (lo, hi) in shadow_ranges(first, t_min) {
+            let want = bvh.closest_hit(o, d, lo, hi).is_some();
+            assert_eq!(bvh.any_hit(o, d, lo, hi), want, "ray {k} ({lo}, {hi})");
+            let portable = bvh.closest_hit_portable(o, d, lo, hi).is_some();
+            assert_eq!(
+                bvh.any_hit_portable(o, d, lo, hi),
+                portable,
+                "ray {k} ({lo}, {hi}), SSE path"
+            );
+            compared += 2;
+            hit += want as usize + portable as usize;
+        }
+    }
+    (compared, hit)
+}
+
+#[test]
+fn any_hit_is_closest_hit_is_some_on_random_meshes() {
+    let mut total = (0, 0);
+    let mut add = |(c, h): (usize, usize)| {
+        total.0 += c;
+        total.1 += h;
+    };
+    for (n, seed) in [(1, 7), (9, 1), (50, 11), (2000, 13), (20_000, 17)] {
+        let (pos, tris) = random_mesh(n, seed);
+        // Both leaf sizings: one triangle per leaf, and the AVX leaves of up to eight.
+        for block in [1, WIDTH as u32] {
+            let bvh = TriangleBvh::build_with(&pos, &tris, sah::LeafBlock(block));
+            add(assert_any_hit_agrees(
+                &bvh,
+                &rays_toward(Vec3::ZERO, 2.0, 1500, 99 + seed),
+                0.0,
+            ));
+        }
+        // Rays from inside the mesh, axis-parallel ones among them, from a small t_min.
+        let bvh = build_checked(&pos, &tris);
+        let mut r = Rng(seed + 5);
+        let mut rays = Vec::new();
+        for _ in 0..150 {
+            let o = r.v() * 3.0 - 1.5;
+            for d in [Vec3::X, Vec3::NEG_Y, Vec3::Z, r.v() - 0.5] {
+                rays.push(Ray::new(o, d));
+            }
+        }
+        add(assert_any_hit_agrees(&bvh, &rays, 1e-4));
+    }
+    println!("{} any-hit comparisons, {} of them hits", total.0, total.1);
+    assert!(total.1 > total.0 / 4 && total.1 < total.0, "{total:?}");
+}
+
+/// Overflowing triangles (whose AVX lanes go to the scalar test) and degenerate and
+/// non-finite rays: the same answers as the closest hit.
+#[test]
+fn any_hit_agrees_on_overflowing_triangles_and_odd_rays() {
+    let mut r = Rng(3);
+    let mut pos = Vec::new();
+    let mut tris = Vec::new();
+    for i in 0..400u32 {
+        for _ in 0..3 {
+            let scale = if r.f() < 0.5 { 4.0 } else { 3.0e38 };
+            pos.push((r.v() * 2.0 - 1.0) * scale);
+        }
+        tris.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    let bvh = build_checked(&pos, &tris);
+    let (compared, hits) =
+        assert_any_hit_agrees(&bvh, &rays_toward(Vec3::ZERO, 4.0, 2000, 19), 0.0);
+    assert!(hits > 100, "{hits} of {compared}");
+    let odd = [
+        Ray::new(Vec3::ZERO, Vec3::ZERO),
+        Ray::new(Vec3::splat(f32::NAN), Vec3::X),
+        Ray::new(Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 0.0)),
+    ];
+    for ray in odd {
+        let (o, d) = (ray.origin.into(), ray.direction.into());
+        assert!(!bvh.any_hit(o, d, 0.0, f32::INFINITY), "{ray:?}");
+        assert!(
+            bvh.closest_hit(o, d, 0.0, f32::INFINITY).is_none(),
+            "{ray:?}"
+        );
+    }
+    let empty = build_checked(&[], &[]);
+    assert!(!empty.any_hit(Vec3A::ZERO, Vec3A::X, 0.0, f32::INFINITY));
+}
+
+/// On the scanned meshes, camera-like and random rays.
+#[test]
+#[ignore = "needs the scanned meshes: TRACELAB_MESHES_DIR, default ../shared/meshes"]
+fn any_hit_agrees_on_shared_meshes() {
+    let dir = crate::test_data::meshes_dir();
+    for name in ["cube.obj", "bunny_1k.obj", "stanford-bunny.obj"] {
+        let mesh =
+            crate::format::obj::load_obj(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let bvh = build_checked(&mesh.positions, &mesh.triangles);
+        let b = bvh.bounds();
+        let radius = b.extent().max_element() * 0.5;
+        let mut rays = rays_toward(b.center(), radius, 3000, 41);
+        rays.extend(pinhole_tiles(
+            b.center() + Vec3::new(0.3, 0.5, 3.0) * radius,
+            b.center(),
+            64,
+            0.8,
+        ));
+        let (compared, hits) = assert_any_hit_agrees(&bvh, &rays, 0.0);
+        println!("{name}: {compared} any-hit comparisons, {hits} hits");
+        assert!(hits > 0 && hits < compared, "{name}");
+    }
+}

@@ -1,5 +1,5 @@
 //! One ray through the tree: the closest hit (the SSE slab test anywhere, the AVX kernels
-//! where the CPU has them) and every hit (for CSG).
+//! where the CPU has them), whether there is any hit (shadow rays) and every hit (for CSG).
 
 use glam::{Vec3A, Vec4};
 
@@ -132,8 +132,14 @@ pub(super) fn nearest_first<E: StackEntry>(
 /// The closest-hit traversal, generic over the 8-box test and the leaf test, and inlined
 /// into the function that picks them so each copy is compiled for the instruction set that
 /// function enables (`closest_hit_portable`, `closest_hit_avx`).
+///
+/// With `FIRST` it returns at the first leaf hit instead (`any_hit`). Until that hit, t_best
+/// is still t_max, so it takes the very steps the closest-hit walk takes: the same boxes,
+/// the same leaves, the same tests. It finds a hit exactly when the closest-hit walk does.
+/// (An unordered walk would not: `pop_within` drops a pushed child entered past t_max,
+/// while the nearest child, visited without a pop, is entered up to `SLAB_WIDEN` past it.)
 #[inline(always)]
-fn closest_hit_with(
+fn closest_hit_with<const FIRST: bool>(
     bvh: &TriangleBvh,
     r: &SlabRay,
     t_min: f32,
@@ -153,6 +159,12 @@ fn closest_hit_with(
         if wide::is_leaf(cur) {
             let (first, count) = wide::leaf_range(cur);
             if let Some((t, k)) = leaf(r, first, count, t_min, t_best) {
+                if FIRST {
+                    return Some(TriangleHit {
+                        t,
+                        triangle: bvh.ids[k],
+                    });
+                }
                 t_best = t;
                 best = k;
             }
@@ -215,7 +227,7 @@ impl TriangleBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
-        closest_hit_with(
+        closest_hit_with::<false>(
             self,
             &SlabRay::new(o, d),
             t_min,
@@ -230,7 +242,7 @@ impl TriangleBvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn closest_hit_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
-        closest_hit_with(
+        closest_hit_with::<false>(
             self,
             &SlabRay::new(o, d),
             t_min,
@@ -240,6 +252,55 @@ impl TriangleBvh {
             },
             |r, first, count, t_min, t_best| avx::leaf8(self, r, first, count, t_min, t_best),
         )
+    }
+
+    /// Whether any triangle is hit with t in (t_min, t_max): a shadow ray's question. It
+    /// stops at the first hit found, and answers exactly `closest_hit(..).is_some()`, on
+    /// every instruction set (the same walk up to that hit, the same triangle test).
+    #[inline]
+    pub fn any_hit(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        // As in `closest_hit`: a non-finite ray would loop through the empty slots.
+        if !finite_ray(o, d) {
+            return false;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if has_avx() {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above (std caches the answer).
+            return unsafe { self.any_hit_avx(o, d, t_min, t_max) };
+        }
+        self.any_hit_portable(o, d, t_min, t_max)
+    }
+
+    /// `any_hit` with SSE only; not inlined, as `closest_hit_portable`.
+    #[inline(never)]
+    pub(super) fn any_hit_portable(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        closest_hit_with::<true>(
+            self,
+            &SlabRay::new(o, d),
+            t_min,
+            t_max,
+            SlabRay::slab8,
+            |r, first, count, t_min, t_best| self.leaf_scalar(r, first, count, t_min, t_best),
+        )
+        .is_some()
+    }
+
+    /// `any_hit` with the AVX kernels of `closest_hit_avx`.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn any_hit_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        closest_hit_with::<true>(
+            self,
+            &SlabRay::new(o, d),
+            t_min,
+            t_max,
+            |r, n, t_min, t_max, t_enter| {
+                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+            },
+            |r, first, count, t_min, t_best| avx::leaf8(self, r, first, count, t_min, t_best),
+        )
+        .is_some()
     }
 
     /// The nearest hit in (t_min, t_best) among triangles first..first+count, one at a time:
