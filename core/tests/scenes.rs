@@ -89,7 +89,7 @@ fn round_trip(path: &Path, scene: &Scene) -> (String, Scene) {
     (text, back)
 }
 
-/// Words of the course's assignment 1–2 grammar.
+/// Words of the course's assignment 1–4 grammar.
 const COURSE_WORDS: &[&str] = &[
     "OrthographicCamera",
     "PerspectiveCamera",
@@ -101,6 +101,10 @@ const COURSE_WORDS: &[&str] = &[
     "Lights",
     "numLights",
     "DirectionalLight",
+    // Assignment 4's words (the course's grammar of assignments 1-4).
+    "PointLight",
+    "position",
+    "attenuation",
     "color",
     "Background",
     "ambientLight",
@@ -111,6 +115,9 @@ const COURSE_WORDS: &[&str] = &[
     "diffuseColor",
     "specularColor",
     "exponent",
+    "reflectiveColor",
+    "transparentColor",
+    "indexOfRefraction",
     "Group",
     "numObjects",
     "MaterialIndex",

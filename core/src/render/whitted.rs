@@ -470,10 +470,11 @@ fn light_term<R: Record>(
     c
 }
 
-/// Whether anything lies on the shadow ray before the light.
+/// Whether anything lies on the shadow ray before the light: the any-hit query, which stops
+/// at the first blocker it finds (the same answer as a closest hit, tested bit for bit).
 #[inline]
 fn blocked(scene: &CompiledScene, shadow: &Ray, dist: f32) -> bool {
-    scene.intersect(shadow, SECONDARY_T_MIN, dist).is_some()
+    scene.occluded(shadow, SECONDARY_T_MIN, dist)
 }
 
 /// The handout's `transmittedDirection`: `d` (unit) crossing from index `n_i` into `n_t`

@@ -7,7 +7,6 @@
 //! | `TRACELAB_SEMESTER_DIR` | `../shared/mit6837-semester` | assignments 3–7: `scenes/` (with their meshes), `commands.txt`, references |
 //! | `TRACELAB_MESHES_DIR` | `../shared/meshes` | scanned meshes (cube, bunnies, dragon) |
 //! | `TRACELAB_PERF_DIR` | `../shared/perf` | the benchmark scenes (`bench_*.txt`) |
-//! | `TRACELAB_SEMESTER_DIR` | `../shared/mit6837-semester` | assignments 3–7: scenes, `commands.txt`, reference images |
 //!
 //! A relative value is taken from the workspace root, whatever folder cargo runs the test in.
 //! Tests that read one are `#[ignore = "needs …"]`: a plain `cargo test` lists them as
@@ -29,7 +28,7 @@ pub fn course_dir() -> PathBuf {
 }
 
 /// The course's later assignments (3 to 7): `scenes/` with their meshes, `commands.txt`,
-/// `reference/`. Many of its scenes use features tracelab does not read (yet).
+/// `reference/`. Scenes of assignments 5–7 use features tracelab does not read (yet).
 pub fn semester_dir() -> PathBuf {
     required(
         "TRACELAB_SEMESTER_DIR",
@@ -53,15 +52,6 @@ pub fn perf_dir() -> PathBuf {
         "TRACELAB_PERF_DIR",
         "../shared/perf",
         "the benchmark scenes (bench_*.txt)",
-    )
-}
-
-/// The course's later weeks (assignments 3–7): `scenes/`, `commands.txt`, `reference/`.
-pub fn semester_dir() -> PathBuf {
-    required(
-        "TRACELAB_SEMESTER_DIR",
-        "../shared/mit6837-semester",
-        "the course's assignment 3-7 files (scenes, commands.txt, reference images)",
     )
 }
 

@@ -208,7 +208,9 @@ impl Parser<'_> {
             self.error(x.name_off, msg);
             ok = false;
         }
-        for x in &f {
+        // Each field's count of numbers, once the block's shape is sound.
+        let sound = ok;
+        for x in f.iter().filter(|_| sound) {
             match phong_field(&x.name) {
                 Some(p) if x.values.len() != p.numbers => {
                     let msg = format!(
