@@ -4,6 +4,9 @@
 
 use std::path::PathBuf;
 
+use tracelab_core::RenderSettings;
+use tracelab_core::render::{Secondary, ShadowQuery};
+
 /// `println!` that checks the write (a full disk is an error, a closed pipe ends the run).
 macro_rules! out {
     ($($arg:tt)*) => {
@@ -90,6 +93,47 @@ pub struct ProgressiveArgs {
     /// passes and the full one: what the progressive passes cost on top.
     #[arg(long)]
     pub one_pass: bool,
+    /// Shadow rays toward every light (the course's -shadows).
+    #[arg(long)]
+    pub shadows: bool,
+    /// Levels of reflected and refracted rays (the course's -bounces; 0 to 100).
+    #[arg(long, default_value_t = 0)]
+    pub bounces: u32,
+    /// Rays whose weight is below this are not traced (the course's -weight).
+    #[arg(long, default_value_t = 0.0)]
+    pub weight: f32,
+    /// Flip back faces toward the eye (the course's -shade_back).
+    #[arg(long)]
+    pub shade_back: bool,
+    /// Ask shadow rays by the closest hit instead of the any-hit query (the same image; to
+    /// measure what stopping at the first blocker saves).
+    #[arg(long)]
+    pub closest_hit_shadows: bool,
+}
+
+impl ProgressiveArgs {
+    /// The render settings these flags ask for, checked as `render`'s are.
+    pub fn settings(&self, w: u32, h: u32) -> anyhow::Result<RenderSettings> {
+        let secondary = Secondary {
+            shadows: self.shadows,
+            bounces: self.bounces,
+            weight: self.weight,
+            shadow_query: if self.closest_hit_shadows {
+                ShadowQuery::ClosestHit
+            } else {
+                ShadowQuery::AnyHit
+            },
+            ..Secondary::default()
+        };
+        secondary
+            .check_flags("--bounces", "--weight")
+            .map_err(crate::exit::usage)?;
+        Ok(RenderSettings {
+            shade_back: self.shade_back,
+            secondary,
+            ..RenderSettings::new(w, h)
+        })
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

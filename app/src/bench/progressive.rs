@@ -25,8 +25,8 @@ type Run = (f64, f64, Vec<(u32, f64)>);
 pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
     let (w, h) = (b.size[0], b.size[1]);
     check_size(w, h)?;
+    let settings = b.settings(w, h)?;
     let scene = load_scene(Some(&b.scene))?;
-    let settings = RenderSettings::new(w, h);
     let target = SharedFrame::try_sized(w, h)?;
     let tracing = if b.single_rays {
         Tracing::SingleRays
@@ -34,6 +34,11 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         Tracing::Packets
     };
     // (first coarse image, full frame, each pass's scale and own time), in ms.
+    // A line whose rays would never finish is refused, as `render` refuses it.
+    settings
+        .secondary
+        .check_bounded(&CompiledScene::new(&scene))
+        .map_err(crate::exit::usage)?;
     let once = || {
         let start = Instant::now();
         let compiled = CompiledScene::new(&scene);
@@ -86,7 +91,7 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         })
         .collect();
     out!(
-        "frame: {w}x{h}, {} threads, {} kernels, medians of {}, {}, primary rays {}",
+        "frame: {w}x{h}, {} threads, {} kernels, medians of {}, {}, primary rays {}{}",
         rayon::current_num_threads(),
         tracelab_core::simd::level().name(),
         runs.len(),
@@ -99,7 +104,8 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
             "one at a time"
         } else {
             "in packets of 8"
-        }
+        },
+        secondary_text(&settings)
     );
     out!(
         "passes: {} ms each (scale, median; the first from the compile on)",
@@ -110,6 +116,25 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         run_orbit(&scene, &settings, steps.max(1))?;
     }
     Ok(())
+}
+
+/// The assignment 3–4 settings, when any is on.
+fn secondary_text(s: &RenderSettings) -> String {
+    let x = &s.secondary;
+    if !x.shadows && x.bounces == 0 && !s.shade_back {
+        return String::new();
+    }
+    format!(
+        "; shadows {}, bounces {}, weight {}, shade back {}, shadow rays by {}",
+        if x.shadows { "on" } else { "off" },
+        x.bounces,
+        x.weight,
+        if s.shade_back { "on" } else { "off" },
+        match x.shadow_query {
+            tracelab_core::render::ShadowQuery::AnyHit => "the any-hit query",
+            tracelab_core::render::ShadowQuery::ClosestHit => "the closest hit",
+        }
+    )
 }
 
 /// A turn of the camera about the scene's centre in `steps` steps, each as the editor

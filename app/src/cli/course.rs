@@ -11,10 +11,6 @@ use super::values::{parse_count, parse_f32, parse_u32};
 use crate::exit::usage;
 use crate::io::write_stderr_text;
 
-/// The most levels of secondary rays `-bounces` takes: deeper than any course scene needs
-/// (10), and shallow enough that the recursion stays well inside a thread's stack.
-pub const MAX_BOUNCES: u32 = 100;
-
 /// Flags of the course's later weeks that tracelab does not implement yet: refused by name,
 /// never ignored (an image made without them would be silently wrong).
 const NOT_YET: [(&str, &str); 11] = [
@@ -77,22 +73,10 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
             "-shadows" => job.secondary.shadows = true,
             "-specular_fix" => job.secondary.specular_fix = true,
             "-bounces" => {
-                let n = parse_count(&take(&mut it, a)?, "-bounces")?;
-                if n > MAX_BOUNCES {
-                    return Err(usage(format!(
-                        "-bounces: at most {MAX_BOUNCES} levels, found {n}"
-                    )));
-                }
-                job.secondary.bounces = n;
+                job.secondary.bounces = parse_count(&take(&mut it, a)?, "-bounces")?;
             }
             "-weight" => {
-                let w = parse_f32(&take(&mut it, a)?, "-weight")?;
-                if !(w.is_finite() && w >= 0.0) {
-                    return Err(usage(format!(
-                        "-weight: expected a number of 0 or more, found {w}"
-                    )));
-                }
-                job.secondary.weight = w;
+                job.secondary.weight = parse_f32(&take(&mut it, a)?, "-weight")?;
             }
             "-gui" | "-gouraud" => preview.push(a.to_string()),
             "-tessellation" => {
@@ -143,6 +127,9 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     if job.width == 0 {
         return Err(usage("-size W H is required"));
     }
+    job.secondary
+        .check_flags("-bounces", "-weight")
+        .map_err(usage)?;
     if !preview.is_empty() {
         write_stderr_text(&format!(
             "tracelab: note: {} only set the course's OpenGL preview, which tracelab does not \

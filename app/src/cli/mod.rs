@@ -44,7 +44,9 @@ use crate::io::{write_stderr_text, write_stdout};
         With no arguments, opens the editor on a built-in scene; with a SCENE, opens that file.\n\
         The course's own command lines work unchanged, e.g.\n  \
         tracelab -input scene2_05_inside_sphere.txt -size 200 200 -output out.tga \\\n    \
-        -depth 9 11 depth.tga -normals normals.tga -shade_back\n\n\
+        -depth 9 11 depth.tga -normals normals.tga -shade_back\n  \
+        tracelab -input scene4_14_faceted_gem.txt -size 200 200 -output out.png \\\n    \
+        -shadows -shade_back -bounces 5 -weight 0.01\n\n\
         Images are at most 16384 pixels a side and 67108864 (8192x8192) pixels in all.",
     args_conflicts_with_subcommands = true
 )]

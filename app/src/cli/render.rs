@@ -65,25 +65,15 @@ pub struct SecondaryArgs {
 impl SecondaryArgs {
     /// The secondary-ray settings, checked as the course form checks them.
     pub fn secondary(&self) -> anyhow::Result<Secondary> {
-        if self.bounces > super::course::MAX_BOUNCES {
-            return Err(usage(format!(
-                "--bounces: at most {} levels, found {}",
-                super::course::MAX_BOUNCES,
-                self.bounces
-            )));
-        }
-        if !(self.weight.is_finite() && self.weight >= 0.0) {
-            return Err(usage(format!(
-                "--weight: expected a number of 0 or more, found {}",
-                self.weight
-            )));
-        }
-        Ok(Secondary {
+        let s = Secondary {
             shadows: self.shadows,
             bounces: self.bounces,
             weight: self.weight,
             specular_fix: self.specular_fix,
-        })
+            ..Secondary::default()
+        };
+        s.check_flags("--bounces", "--weight").map_err(usage)?;
+        Ok(s)
     }
 }
 

@@ -333,8 +333,36 @@ fn course_groups(rng: &mut Rng, ctx: &Ctx, for_diff: bool) -> Vec<Group> {
         );
         g.push(group(vec![plain("-object_rays"), plain(v)]));
     }
+    // Assignments 3-4: shadows, bounces (capped at 100; rays that would double past the cap
+    // refused), weight, the optional fix, and the preview's flags (accepted with a note).
+    if rng.one_in(4) {
+        g.push(group(vec![plain("-shadows")]));
+    }
+    if rng.one_in(4) {
+        let v = ctx.pick(rng, "0|1|3|5|10", "100|101|-1|4294967296|1e3|two|");
+        g.push(group(vec![plain("-bounces"), plain(v)]));
+    }
+    if rng.one_in(4) {
+        let v = ctx.pick(rng, "0|0.01|0.5|1", "nan|inf|-0.5|1e39|-0|x|");
+        g.push(group(vec![plain("-weight"), plain(v)]));
+    }
+    if rng.one_in(8) {
+        g.push(group(vec![plain("-specular_fix")]));
+    }
+    if rng.one_in(8) {
+        let preview = rng.word("-gui|-gouraud|-tessellation");
+        let mut v = vec![plain(preview)];
+        if preview == "-tessellation" {
+            v.push(plain(ctx.pick(rng, "10|40", "0|-1|x")));
+            v.push(plain(ctx.pick(rng, "5|20", "0|1e9|")));
+        }
+        g.push(group(v));
+    }
     if ctx.hostile(rng) && rng.one_in(3) {
-        let flag = rng.word("-bogus|-size2|-Input|-|--input|-jitter|-output=x.png");
+        let flag = rng.word(
+            "-bogus|-size2|-Input|-|--input|-jitter|-output=x.png|-grid|-stats|-visualize_grid|\
+             -box_filter",
+        );
         g.push(group(vec![plain(flag)]));
     }
     g

@@ -32,8 +32,8 @@ pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use whitted::{
-    Blocker, Cut, LightShare, MAX_SECONDARY_RAYS, RayKind, RayNode, SECONDARY_T_MIN, Secondary,
-    ShadowRay, needs_whitted, ray_tree, transmitted,
+    Blocker, Cut, LightShare, MAX_BOUNCES, MAX_SECONDARY_RAYS, RayKind, RayNode, SECONDARY_T_MIN,
+    Secondary, ShadowQuery, ShadowRay, needs_whitted, ray_tree, transmitted,
 };
 
 /// How world normals are obtained from object-space ones under a Transform.

@@ -40,7 +40,24 @@ pub struct Secondary {
     /// The handout's optional fix: the highlight fades with max(N·L, 0) instead of stopping
     /// where N·L ≤ 0.
     pub specular_fix: bool,
+    /// How shadow rays are asked (the same answer either way; for `bench-progressive`).
+    pub shadow_query: ShadowQuery,
 }
+
+/// How a shadow ray asks whether anything lies before the light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadowQuery {
+    /// `CompiledScene::occluded`: stops at the first blocker found.
+    #[default]
+    AnyHit,
+    /// The closest hit, then its t compared: what the any-hit query saves is measured
+    /// against this.
+    ClosestHit,
+}
+
+/// The most levels `-bounces` takes: deeper than any course scene needs (10), and shallow
+/// enough that the recursion stays well inside a thread's stack.
+pub const MAX_BOUNCES: u32 = 100;
 
 impl Default for Secondary {
     /// The course's defaults: no shadows, no bounces, every ray traced, no fix.
@@ -50,6 +67,7 @@ impl Default for Secondary {
             bounces: 0,
             weight: 0.0,
             specular_fix: false,
+            shadow_query: ShadowQuery::AnyHit,
         }
     }
 }
@@ -61,6 +79,24 @@ impl Default for Secondary {
 pub const MAX_SECONDARY_RAYS: f64 = 65536.0;
 
 impl Secondary {
+    /// The command line's `-bounces` and `-weight` checked: at most [`MAX_BOUNCES`] levels, a
+    /// weight that is a number of 0 or more. The message names the flag as `flag` spells it.
+    pub fn check_flags(&self, bounces_flag: &str, weight_flag: &str) -> Result<(), String> {
+        if self.bounces > MAX_BOUNCES {
+            return Err(format!(
+                "{bounces_flag}: at most {MAX_BOUNCES} levels, found {}",
+                self.bounces
+            ));
+        }
+        if !(self.weight.is_finite() && self.weight >= 0.0) {
+            return Err(format!(
+                "{weight_flag}: expected a number of 0 or more, found {}",
+                self.weight
+            ));
+        }
+        Ok(())
+    }
+
     /// An upper bound on the reflected and refracted rays one eye ray leads to in `scene`
     /// (shadow rays aside: one per light at each of these): Σ b^k for k = 1..=bounces, b the
     /// most secondary rays one material spawns (0, 1 or 2).
@@ -98,9 +134,14 @@ impl Secondary {
         {
             most -= 1;
         }
+        let worst = if worst < 1e12 {
+            format!("{worst:.0}")
+        } else {
+            format!("about {worst:.1e}")
+        };
         Err(format!(
             "-bounces {}: a material of this scene both reflects and refracts, so one pixel \
-             could trace up to {worst:.0} secondary rays; at most {MAX_SECONDARY_RAYS:.0} are \
+             could trace up to {worst} secondary rays; at most {MAX_SECONDARY_RAYS:.0} are \
              allowed (-bounces {most} or fewer here)",
             self.bounces
         ))
@@ -447,7 +488,7 @@ fn light_term<R: Record>(
             rec.shadow(i, &shadow, dist, b.map(|h| (h.t, scene.hit_node(&h))));
             b.is_some()
         } else {
-            blocked(scene, &shadow, dist)
+            blocked(scene, &shadow, dist, s.secondary.shadow_query)
         };
         if blocked {
             rec.light(i, Vec3::ZERO);
@@ -473,8 +514,11 @@ fn light_term<R: Record>(
 /// Whether anything lies on the shadow ray before the light: the any-hit query, which stops
 /// at the first blocker it finds (the same answer as a closest hit, tested bit for bit).
 #[inline]
-fn blocked(scene: &CompiledScene, shadow: &Ray, dist: f32) -> bool {
-    scene.occluded(shadow, SECONDARY_T_MIN, dist)
+fn blocked(scene: &CompiledScene, shadow: &Ray, dist: f32, query: ShadowQuery) -> bool {
+    match query {
+        ShadowQuery::AnyHit => scene.occluded(shadow, SECONDARY_T_MIN, dist),
+        ShadowQuery::ClosestHit => scene.intersect(shadow, SECONDARY_T_MIN, dist).is_some(),
+    }
 }
 
 /// The handout's `transmittedDirection`: `d` (unit) crossing from index `n_i` into `n_t`

@@ -1,0 +1,299 @@
+//! Assignments 3–4 on the command line: `-shadows -bounces -weight -specular_fix`, the
+//! preview flags noted, later weeks' flags refused by name, hostile values, rays that would
+//! never finish refused before any work, and the ray tree in `inspect`.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use common::repo;
+
+fn tracelab(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run tracelab")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+fn scene() -> String {
+    repo().join("scenes/mirror_glass.txt").display().to_string()
+}
+
+#[test]
+fn the_handout_flags_render_and_change_the_image() {
+    let d = common::temp_dir("rays", "flags");
+    let s = scene();
+    let plain = tracelab(&["-input", &s, "-size", "40", "40", "-output", "a.png"], &d);
+    assert!(plain.status.success(), "{}", stderr(&plain));
+    let full = tracelab(
+        &[
+            "-input",
+            &s,
+            "-size",
+            "40",
+            "40",
+            "-output",
+            "b.png",
+            "-shadows",
+            "-bounces",
+            "4",
+            "-weight",
+            "0.01",
+            "-shade_back",
+        ],
+        &d,
+    );
+    assert!(full.status.success(), "{}", stderr(&full));
+    let a = std::fs::read(d.join("a.png")).expect("a.png");
+    let b = std::fs::read(d.join("b.png")).expect("b.png");
+    assert_ne!(a, b, "shadows and bounces must show in the image");
+    // `render` spells them as long options and gives the same bytes.
+    let long = tracelab(
+        &[
+            "render",
+            &s,
+            "--size",
+            "40",
+            "40",
+            "--output",
+            "c.png",
+            "--shadows",
+            "--bounces",
+            "4",
+            "--weight",
+            "0.01",
+            "--shade-back",
+        ],
+        &d,
+    );
+    assert!(long.status.success(), "{}", stderr(&long));
+    assert_eq!(std::fs::read(d.join("c.png")).expect("c.png"), b);
+}
+
+#[test]
+fn preview_flags_are_accepted_with_a_note_and_later_weeks_flags_are_refused_by_name() {
+    let d = common::temp_dir("rays", "preview");
+    let s = scene();
+    let o = tracelab(
+        &[
+            "-input",
+            &s,
+            "-size",
+            "20",
+            "20",
+            "-output",
+            "a.png",
+            "-gui",
+            "-tessellation",
+            "10",
+            "5",
+            "-gouraud",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("-gui, -tessellation 10 5, -gouraud") && e.contains("tracelab SCENE"),
+        "{e}"
+    );
+    for (flag, extra) in [
+        ("-grid", &["10", "10", "10"][..]),
+        ("-visualize_grid", &[][..]),
+        ("-stats", &[][..]),
+        ("-jittered_samples", &["4"][..]),
+        ("-gaussian_filter", &["0.5"][..]),
+    ] {
+        let mut args = vec!["-input", &s, "-size", "20", "20", "-output", "g.png", flag];
+        args.extend(extra);
+        let o = tracelab(&args, &d);
+        assert_eq!(o.status.code(), Some(2), "{flag}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!("{flag} (assignment"))
+                && stderr(&o).contains("not implemented"),
+            "{flag}: {}",
+            stderr(&o)
+        );
+        assert!(!d.join("g.png").exists(), "{flag} wrote an image");
+    }
+}
+
+#[test]
+fn hostile_bounce_and_weight_values_are_usage_errors_naming_the_flag() {
+    let d = common::temp_dir("rays", "hostile");
+    let s = scene();
+    for (flag, value) in [
+        ("-bounces", "101"),
+        ("-bounces", "-1"),
+        ("-bounces", "4294967296"),
+        ("-bounces", "two"),
+        ("-bounces", ""),
+        ("-weight", "nan"),
+        ("-weight", "inf"),
+        ("-weight", "-0.5"),
+        ("-weight", "1e39"),
+        ("-weight", "x"),
+    ] {
+        let o = tracelab(
+            &[
+                "-input", &s, "-size", "8", "8", "-output", "h.png", flag, value,
+            ],
+            &d,
+        );
+        assert_eq!(o.status.code(), Some(2), "{flag} {value:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(flag),
+            "{flag} {value:?}: {}",
+            stderr(&o)
+        );
+    }
+    // The edges that are fine (in a scene whose rays do not branch, for -bounces 100).
+    let plain = repo().join("scenes/default.txt").display().to_string();
+    for (flag, value) in [("-bounces", "0"), ("-bounces", "100"), ("-weight", "0")] {
+        let o = tracelab(
+            &[
+                "-input", &plain, "-size", "8", "8", "-output", "ok.png", flag, value,
+            ],
+            &d,
+        );
+        assert!(o.status.success(), "{flag} {value}: {}", stderr(&o));
+    }
+    let o = tracelab(&["-input", &s, "-size", "8", "8", "-bounces"], &d);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("-bounces needs a value"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn rays_that_would_double_past_the_cap_are_refused_before_any_work() {
+    // mirror_glass.txt's glass both reflects and refracts: 2 + 4 + … + 2^15 = 65,534
+    // secondary rays a pixel at -bounces 15, twice that at 16.
+    let d = common::temp_dir("rays", "cap");
+    let s = scene();
+    let run = |b: &str| {
+        tracelab(
+            &[
+                "-input", &s, "-size", "1", "1", "-output", "o.png", "-bounces", b,
+            ],
+            &d,
+        )
+    };
+    let o = run("16");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("-bounces 15 or fewer here"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!d.join("o.png").exists());
+    // At the cap it renders (one pixel: quick whatever it meets).
+    let o = run("15");
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A scene whose rays do not branch takes any count up to 100.
+    let o = tracelab(
+        &[
+            "-input",
+            &repo().join("scenes/default.txt").display().to_string(),
+            "-size",
+            "4",
+            "4",
+            "-output",
+            "p.png",
+            "-bounces",
+            "100",
+        ],
+        &d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn inspect_prints_the_ray_tree_whose_root_is_the_pixel_s_colour() {
+    let d = common::temp_dir("rays", "inspect");
+    let s = scene();
+    let args = [
+        "inspect",
+        &s,
+        "--size",
+        "60",
+        "60",
+        "--pixel",
+        "40",
+        "30",
+        "--shadows",
+        "--bounces",
+        "3",
+        "--weight",
+        "0.01",
+        "--shade-back",
+    ];
+    let o = tracelab(&args, &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("ray tree"), "{text}");
+    assert!(text.contains("refracted ray"), "{text}");
+    let mut json = args.to_vec();
+    json.push("--json");
+    let o = tracelab(&json, &d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    let tree = &v["ray_tree"];
+    assert_eq!(tree["kind"], "eye");
+    assert_eq!(tree["color"], v["color"], "the root brings back the pixel");
+    assert_eq!(v["settings"]["bounces"], 3);
+    // The pixel's bytes are what the render writes for the same line.
+    let r = tracelab(
+        &[
+            "render",
+            &s,
+            "--size",
+            "60",
+            "60",
+            "--output",
+            "r.png",
+            "--shadows",
+            "--bounces",
+            "3",
+            "--weight",
+            "0.01",
+            "--shade-back",
+        ],
+        &d,
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    let img = image::open(d.join("r.png")).expect("r.png").to_rgb8();
+    let px = img.get_pixel(40, 30).0;
+    let rgb8: Vec<u64> = v["rgb8"]
+        .as_array()
+        .expect("rgb8")
+        .iter()
+        .map(|x| x.as_u64().unwrap_or(999))
+        .collect();
+    assert_eq!(rgb8, px.iter().map(|&b| u64::from(b)).collect::<Vec<_>>());
+    // Without anything beyond diffuse shading there is no tree.
+    let o = tracelab(
+        &[
+            "inspect",
+            &repo().join("scenes/default.txt").display().to_string(),
+            "--size",
+            "20",
+            "20",
+            "--pixel",
+            "10",
+            "10",
+            "--json",
+        ],
+        &d,
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert!(v["ray_tree"].is_null());
+}
