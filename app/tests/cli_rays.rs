@@ -104,11 +104,9 @@ fn preview_flags_are_accepted_with_a_note_and_later_weeks_flags_are_refused_by_n
         "{e}"
     );
     for (flag, extra) in [
-        ("-grid", &["10", "10", "10"][..]),
-        ("-visualize_grid", &[][..]),
-        ("-stats", &[][..]),
         ("-jittered_samples", &["4"][..]),
         ("-gaussian_filter", &["0.5"][..]),
+        ("-render_samples", &["s.png", "4"][..]),
     ] {
         let mut args = vec!["-input", &s, "-size", "20", "20", "-output", "g.png", flag];
         args.extend(extra);
@@ -296,4 +294,67 @@ fn inspect_prints_the_ray_tree_whose_root_is_the_pixel_s_colour() {
     );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
     assert!(v["ray_tree"].is_null());
+}
+
+#[test]
+fn grid_flags_render_the_same_image_print_stats_and_refuse_hostile_counts() {
+    let d = common::temp_dir("rays", "grid");
+    let s = repo()
+        .join("scenes/perspective_mesh.txt")
+        .display()
+        .to_string();
+    let base = ["-input", &s, "-size", "48", "48", "-shadows"];
+    let run = |extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend(extra);
+        tracelab(&a, &d)
+    };
+    let bvh = run(&["-output", "bvh.png"]);
+    assert!(bvh.status.success(), "{}", stderr(&bvh));
+    let grid = run(&["-output", "grid.png", "-grid", "9", "7", "5", "-stats"]);
+    assert!(grid.status.success(), "{}", stderr(&grid));
+    assert_eq!(
+        std::fs::read(d.join("grid.png")).expect("grid.png"),
+        std::fs::read(d.join("bvh.png")).expect("bvh.png"),
+        "the grid changes how rays find hits, not what they find"
+    );
+    let out = String::from_utf8_lossy(&grid.stdout);
+    for line in [
+        "RAY TRACING STATISTICS",
+        "num grid cells                315 (9x7x5)",
+        "num non-shadow rays           2304",
+        "num shadow rays",
+        "cells traversed per ray",
+    ] {
+        assert!(out.contains(line), "{line}:\n{out}");
+    }
+    let vis = run(&[
+        "-output",
+        "vis.png",
+        "-grid",
+        "9",
+        "7",
+        "5",
+        "-visualize_grid",
+    ]);
+    assert!(vis.status.success(), "{}", stderr(&vis));
+    assert_ne!(
+        std::fs::read(d.join("vis.png")).expect("vis.png"),
+        std::fs::read(d.join("bvh.png")).expect("bvh.png")
+    );
+    for (extra, says) in [
+        (&["-grid", "0", "1", "1"][..], "-grid x cells"),
+        (&["-grid", "-1", "1", "1"][..], "-grid x cells"),
+        (&["-grid", "10", "10"][..], "-grid z cells"),
+        (&["-grid", "1024", "1024", "1024"][..], "at most 16777216"),
+        (&["-grid", "nan", "1", "1"][..], "-grid x cells"),
+        (&["-visualize_grid"][..], "give -grid too"),
+    ] {
+        let mut a = extra.to_vec();
+        a.extend(["-output", "bad.png"]);
+        let o = run(&a);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert!(!d.join("bad.png").exists());
+    }
 }

@@ -1,6 +1,6 @@
-//! Conformance with the course's assignments 3 and 4 (Phong highlights, point lights,
-//! shadows, reflection, refraction): every line of `commands.txt` that writes an
-//! `output3_*` or `output4_*` image is run unchanged (with `tracelab` for `raytracer`) in a
+//! Conformance with the course's assignments 3, 4 and 6 (Phong highlights, point lights,
+//! shadows, reflection, refraction; the uniform grid): every line of `commands.txt` that
+//! writes an `output3_*`, `output4_*` or, with a reference, `output6_*` image is run unchanged (with `tracelab` for `raytracer`) in a
 //! temporary copy of the scenes, and each image is judged by the references' own criterion
 //! (`AGREEMENT.md`): it matches when fewer than 1% of its pixels differ from the reference by
 //! more than 2/255 on some channel. The handout's `_fix` images (the optional specular fix,
@@ -55,11 +55,12 @@ fn output_of<'a>(args: &[&'a str]) -> Option<&'a str> {
     args.get(i + 1).copied()
 }
 
-#[test]
-#[ignore = "needs the course's assignment 3-7 files: TRACELAB_SEMESTER_DIR, default ../shared/mit6837-semester"]
-fn every_assignment_3_and_4_line_matches_its_reference() {
+/// Runs every line whose `-output` starts with one of `prefixes` and has a reference (with
+/// its `_fix` twin where one exists), prints the table and returns (images judged,
+/// failures).
+fn run_lines(prefixes: &[&str], area: &str) -> (usize, Vec<String>) {
     let shared = common::semester_dir();
-    let dir = common::temp_dir("semester", "a34");
+    let dir = common::temp_dir("semester", area);
     copy_dir(&shared.join("scenes"), &dir);
     let commands = std::fs::read_to_string(shared.join("commands.txt")).expect("commands.txt");
     let exe = env!("CARGO_BIN_EXE_tracelab");
@@ -71,7 +72,9 @@ fn every_assignment_3_and_4_line_matches_its_reference() {
         let Some(out) = output_of(&args) else {
             continue;
         };
-        if !(out.starts_with("output3_") || out.starts_with("output4_")) {
+        if !prefixes.iter().any(|p| out.starts_with(p))
+            || !shared.join("reference").join(out).is_file()
+        {
             continue;
         }
         jobs.push((args.iter().map(|s| s.to_string()).collect(), out.into()));
@@ -130,17 +133,39 @@ fn every_assignment_3_and_4_line_matches_its_reference() {
         println!("{r}");
     }
     println!(
-        "conformance (assignments 3-4): {} of {} images match; {} runs in {:.2} s",
+        "conformance ({}): {} of {} images match; {} runs in {:.2} s",
+        prefixes.join(", "),
         rows.iter().filter(|r| r.ends_with("pass")).count(),
         rows.len(),
         jobs.len(),
         elapsed.as_secs_f64()
     );
     let _ = std::fs::remove_dir_all(&dir);
+    (rows.len(), failures)
+}
+
+#[test]
+#[ignore = "needs the course's assignment 3-7 files: TRACELAB_SEMESTER_DIR, default ../shared/mit6837-semester"]
+fn every_assignment_3_and_4_line_matches_its_reference() {
+    let (judged, failures) = run_lines(&["output3_", "output4_"], "a34");
     assert!(
         failures.is_empty(),
         "conformance failures:\n{}",
         failures.join("\n")
     );
-    assert_eq!(rows.len(), 42, "expected 15 + 27 reference images");
+    assert_eq!(judged, 42, "expected 15 + 27 reference images");
+}
+
+/// Assignment 6's lines with a reference: the same scenes as before, with `-grid NX NY NZ`
+/// (the uniform grid instead of the BVH) and `-stats` on many of them.
+#[test]
+#[ignore = "needs the course's assignment 3-7 files: TRACELAB_SEMESTER_DIR, default ../shared/mit6837-semester"]
+fn every_assignment_6_line_with_a_reference_matches_it() {
+    let (judged, failures) = run_lines(&["output6_"], "a6");
+    assert!(
+        failures.is_empty(),
+        "conformance failures:\n{}",
+        failures.join("\n")
+    );
+    assert_eq!(judged, 26, "expected 26 reference images");
 }

@@ -13,10 +13,7 @@ use crate::io::write_stderr_text;
 
 /// Flags of the course's later weeks that tracelab does not implement yet: refused by name,
 /// never ignored (an image made without them would be silently wrong).
-const NOT_YET: [(&str, &str); 11] = [
-    ("-grid", "assignment 5's uniform grid"),
-    ("-visualize_grid", "assignment 5's grid view"),
-    ("-stats", "assignment 6's counters"),
+const NOT_YET: [(&str, &str); 8] = [
     ("-random_samples", "assignment 7's sampling"),
     ("-uniform_samples", "assignment 7's sampling"),
     ("-jittered_samples", "assignment 7's sampling"),
@@ -45,6 +42,9 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
         normal_transform: NormalTransform::Correct,
         object_rays: ObjectRays::Unnormalized,
         secondary: Secondary::default(),
+        grid: None,
+        visualize_grid: false,
+        stats: false,
     };
     let mut preview = Vec::new();
     let mut it = args.iter();
@@ -78,6 +78,15 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
             "-weight" => {
                 job.secondary.weight = parse_f32(&take(&mut it, a)?, "-weight")?;
             }
+            "-grid" => {
+                let mut n = [0u32; 3];
+                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                    n[k] = parse_u32(&take(&mut it, a)?, &format!("-grid {axis} cells"))?;
+                }
+                job.grid = Some(n);
+            }
+            "-visualize_grid" => job.visualize_grid = true,
+            "-stats" => job.stats = true,
             "-gui" | "-gouraud" => preview.push(a.to_string()),
             "-tessellation" => {
                 let th = parse_u32(&take(&mut it, a)?, "-tessellation theta steps")?;
@@ -130,6 +139,11 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     job.secondary
         .check_flags("-bounces", "-weight")
         .map_err(usage)?;
+    if job.visualize_grid && job.grid.is_none() {
+        return Err(usage(
+            "-visualize_grid shows the grid -grid NX NY NZ builds: give -grid too",
+        ));
+    }
     if !preview.is_empty() {
         write_stderr_text(&format!(
             "tracelab: note: {} only set the course's OpenGL preview, which tracelab does not \

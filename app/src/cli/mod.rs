@@ -18,6 +18,7 @@ mod progress;
 mod regions;
 mod render;
 mod report_html;
+mod stats;
 mod values;
 
 use std::borrow::Cow;

@@ -96,6 +96,9 @@ pub struct CompiledScene {
     pub(super) bvh: Bvh,
     /// Objects with no finite bounds (planes), tested for every ray.
     pub(super) unbounded: Vec<u32>,
+    /// The course's uniform grid, when `-grid` asks for it: then every ray goes through it
+    /// instead of `bvh` (`grid_scene.rs`).
+    pub(super) grid: Option<Arc<super::grid_scene::GridScene>>,
     /// The one object of a scene that holds a single mesh and nothing else: rays go straight
     /// to it, since the mesh tests its own box first (in object space, needing no second
     /// reciprocal of the direction).
@@ -252,6 +255,7 @@ impl CompiledScene {
             objects,
             bvh,
             unbounded,
+            grid: None,
             single_mesh,
         })
     }
@@ -263,6 +267,9 @@ impl CompiledScene {
     /// memory, where each hop was a failed store forward (docs/perf.md).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
+        if let Some(g) = &self.grid {
+            return self.intersect_grid(g, ray, t_min, t_max);
+        }
         if let Some(i) = self.single_mesh
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
@@ -304,6 +311,14 @@ impl CompiledScene {
         t_max: f32,
         sparse: bool,
     ) -> [Option<Hit>; 8] {
+        if self.grid.is_some() {
+            // The grid walks one ray at a time.
+            return std::array::from_fn(|k| {
+                (active & (1 << k) != 0)
+                    .then(|| self.intersect(&rays[k], t_min, t_max))
+                    .flatten()
+            });
+        }
         if let Some(i) = self.single_mesh
             && let Some(o) = self.objects.get(i as usize)
             && let Shape::Mesh(m) = &o.shape
@@ -505,6 +520,13 @@ impl CompiledScene {
                 .and_then(|o| o.xf.as_ref()),
             n,
         )
+    }
+
+    /// Object `i`'s box in world space (infinite for a plane, empty for none).
+    pub fn object_world_bounds(&self, i: u32) -> Aabb {
+        self.objects
+            .get(i as usize)
+            .map_or(Aabb::EMPTY, object_bounds)
     }
 
     pub fn object_count(&self) -> usize {

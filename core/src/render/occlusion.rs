@@ -13,6 +13,10 @@ impl CompiledScene {
     /// Whether anything is hit with t in (t_min, t_max): `intersect(ray, t_min, t_max)
     /// .is_some()`, returning at the first hit found.
     pub fn occluded(&self, ray: &Ray, t_min: f32, t_max: f32) -> bool {
+        // Under `-grid` every query walks the grid (the course's programs do).
+        if let Some(g) = &self.grid {
+            return self.intersect_grid(g, ray, t_min, t_max).is_some();
+        }
         // `intersect` sends a one-mesh scene straight to the mesh, past the top-level box
         // (whose unwidened slab test could differ at the edge): so must this.
         if let Some(i) = self.single_mesh

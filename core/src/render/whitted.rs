@@ -19,6 +19,7 @@ use glam::Vec3;
 
 use super::RenderSettings;
 use super::compile::{CompiledScene, Hit};
+use super::grid_scene::RayCounts;
 use crate::geometry::Ray;
 use crate::scene::Phong;
 
@@ -362,6 +363,9 @@ fn trace<R: Record>(
     s: &RenderSettings,
     rec: &mut R,
 ) -> Vec3 {
+    if let Some(g) = scene.grid() {
+        RayCounts::add(&g.stats.secondary_rays, 1);
+    }
     let c = match scene.intersect(ray, SECONDARY_T_MIN, f32::INFINITY) {
         None => scene.background,
         Some(hit) => {
@@ -482,6 +486,9 @@ fn light_term<R: Record>(
         return Vec3::ZERO;
     }
     if s.secondary.shadows {
+        if let Some(g) = scene.grid() {
+            RayCounts::add(&g.stats.shadow_rays, 1);
+        }
         let shadow = Ray::new(p, l);
         let blocked = if R::WANTS_BLOCKER {
             let b = scene.intersect(&shadow, SECONDARY_T_MIN, dist);

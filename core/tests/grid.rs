@@ -1,0 +1,288 @@
+//! The course's uniform grid (`-grid`) against the objects' BVH, ray by ray, on real scene
+//! files: the same closest hit (t bit for bit, the same object; the same triangle except
+//! where two triangles give the very same t) for the camera rays of a 48×48 image and rays
+//! from each hit point in fixed directions, at several grid resolutions. A difference is
+//! allowed only for a ray parallel to a coordinate plane (in world space or in the space of
+//! an object involved), at most once in 1,000 rays, and printed: such a ray can run exactly
+//! along a box's or a mesh cube's face, where the objects' BVH (or a mesh's own BVH) culls a
+//! grazing hit by its box test that the grid, testing the object or triangle directly,
+//! finds (one seen: a hit exactly on a triangle's edge, v = −0). Scenes under
+//! scenes/ always; the course's (`TRACELAB_COURSE_DIR`) and the semester's
+//! (`TRACELAB_SEMESTER_DIR`) in `#[ignore]`d tests. Plus the grid's occupancy properties:
+//! every cell a sphere's or triangle's surface passes through lists it, and an empty cell
+//! holds no surface.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use glam::{UVec3, Vec3};
+use tracelab_core::geometry::Ray;
+use tracelab_core::render::Shape;
+use tracelab_core::{CompiledScene, MeshCache, load_scene};
+
+fn scene_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        let rd = std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
+        for p in rd.filter_map(|e| e.ok().map(|e| e.path())) {
+            if p.is_dir() {
+                todo.push(p);
+            } else if p.extension().is_some_and(|e| e == "txt") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn compiled(path: &Path) -> Option<CompiledScene> {
+    let (scene, _) = load_scene(path, &mut MeshCache::new()).into_result().ok()?;
+    Some(CompiledScene::new(&scene))
+}
+
+const DIRS: [Vec3; 3] = [Vec3::Y, Vec3::new(1.0, 1.0, 1.0), Vec3::new(-0.8, 0.3, 0.5)];
+
+/// Whether the ray, in the space of one of `objects`, runs parallel to a coordinate plane
+/// there: along a box's or an axis-aligned mesh's face, where box tests cull by rounding.
+fn grazing_in(c: &CompiledScene, objects: &[u32], ray: &Ray) -> bool {
+    objects.iter().any(|&i| {
+        let d = c.objects[i as usize]
+            .xf
+            .as_ref()
+            .map_or(ray.direction, |xf| {
+                xf.object_from_world.transform_vector3(ray.direction)
+            });
+        ray.direction.cmpeq(Vec3::ZERO).any() || d.cmpeq(Vec3::ZERO).any()
+    })
+}
+
+/// Rays compared, how many hit, and how many one structure hit and the other did not
+/// (printed); panics where both hit and the hits differ.
+fn compare_scene(bvh: &CompiledScene, cells: UVec3, what: &str) -> (u64, u64, u64) {
+    let mut grid = bvh.clone();
+    grid.use_grid(cells).expect("grid");
+    let (mut rays, mut hits, mut grazing) = (0u64, 0u64, 0u64);
+    let mut check = |ray: &Ray, t_min: f32| -> Option<Vec3> {
+        let a = bvh.intersect(ray, t_min, f32::INFINITY);
+        let b = grid.intersect(ray, t_min, f32::INFINITY);
+        rays += 1;
+        match (a, b) {
+            (None, None) => None,
+            (Some(a), Some(b)) if a.t != b.t || a.object != b.object => {
+                // Allowed only for a ray parallel to a coordinate plane: one structure's box
+                // test (the objects' BVH, or a mesh's own) culls a grazing hit that a test
+                // without that box finds.
+                assert!(
+                    grazing_in(bvh, &[a.object, b.object], ray),
+                    "{what}: grid {cells} hit differs for {ray:?}: BVH {a:?}, grid {b:?}"
+                );
+                println!("{what}: grid {cells} for {ray:?}: BVH {a:?}, grid {b:?}");
+                grazing += 1;
+                None
+            }
+            (Some(a), Some(b)) => {
+                assert_eq!(
+                    (a.t.to_bits(), a.object),
+                    (b.t.to_bits(), b.object),
+                    "{what}: grid {cells} hit differs for {ray:?}: BVH {a:?}, grid {b:?}"
+                );
+                if a.prim != b.prim {
+                    // Two triangles of one mesh at the very same t: either is the hit.
+                    assert_eq!(a.t, b.t, "{what}");
+                }
+                hits += 1;
+                Some(ray.at(a.t))
+            }
+            (a, b) => {
+                let objects: Vec<u32> = a.iter().chain(b.iter()).map(|h| h.object).collect();
+                assert!(
+                    grazing_in(bvh, &objects, ray),
+                    "{what}: grid {cells} for {ray:?}: BVH {a:?}, grid {b:?}"
+                );
+                println!("{what}: grid {cells} for {ray:?}: BVH {a:?}, grid {b:?}");
+                grazing += 1;
+                None
+            }
+        }
+    };
+    let n = 48;
+    for row in 0..n {
+        for x in 0..n {
+            let ray = bvh.camera.pixel_ray(x, row, n, n);
+            if let Some(p) = check(&ray, bvh.camera.t_min()) {
+                for d in DIRS {
+                    check(&Ray::new(p, d.normalize()), 1e-4);
+                }
+            }
+        }
+    }
+    (rays, hits, grazing)
+}
+
+fn compare_folder(dir: &Path, at_least: usize) {
+    let (mut scenes, mut rays, mut hits, mut grazing) = (0, 0, 0, 0);
+    // scenes/perf/ is for timing (1,000 mesh instances), not for this.
+    for p in scene_files(dir)
+        .into_iter()
+        .filter(|p| !p.components().any(|c| c.as_os_str() == "perf"))
+    {
+        let Some(c) = compiled(&p) else { continue };
+        let what = p.display().to_string();
+        for cells in [UVec3::ONE, UVec3::new(7, 5, 3), UVec3::splat(16)] {
+            let (r, h, g) = compare_scene(&c, cells, &what);
+            rays += r;
+            hits += h;
+            grazing += g;
+        }
+        scenes += 1;
+    }
+    println!(
+        "{}: {scenes} scenes, {rays} rays, {hits} hits, the grid's closest hit the BVH's; \
+         {grazing} rays hit by one and not the other",
+        dir.display()
+    );
+    assert!(
+        scenes >= at_least,
+        "only {scenes} scenes read in {}",
+        dir.display()
+    );
+    assert!(
+        grazing * 1_000 <= rays,
+        "{grazing} of {rays} rays hit by only one of the grid and the BVH"
+    );
+}
+
+#[test]
+fn the_grid_finds_the_bvh_s_closest_hits_on_our_scenes() {
+    compare_folder(&common::repo().join("scenes"), 20);
+}
+
+#[test]
+#[ignore = "needs the course's files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
+fn the_grid_finds_the_bvh_s_closest_hits_on_the_course_scenes() {
+    compare_folder(&common::course_dir().join("scenes"), 20);
+}
+
+#[test]
+#[ignore = "needs the course's assignment 3-7 files: TRACELAB_SEMESTER_DIR, default ../shared/mit6837-semester"]
+fn the_grid_finds_the_bvh_s_closest_hits_on_the_semester_scenes() {
+    compare_folder(&common::semester_dir().join("scenes"), 40);
+}
+
+/// Points spread over a triangle's surface (its corners, edges' middles, centre, and a
+/// grid of barycentric points).
+fn triangle_points([a, b, c]: [Vec3; 3]) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    let n = 6;
+    for i in 0..=n {
+        for j in 0..=(n - i) {
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            out.push(a + (b - a) * u + (c - a) * v);
+        }
+    }
+    out
+}
+
+fn sphere_points(c: Vec3, r: f32) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for i in 0..24 {
+        for j in 0..12 {
+            let (th, ph) = (
+                i as f32 / 24.0 * std::f32::consts::TAU,
+                (j as f32 + 0.5) / 12.0 * std::f32::consts::PI,
+            );
+            out.push(c + r * Vec3::new(ph.sin() * th.cos(), ph.cos(), ph.sin() * th.sin()));
+        }
+    }
+    out
+}
+
+/// Every surface point of an object lies in a cell that lists that object, and no point of
+/// any surface lies in an empty cell. Points within a hair of a cell face are skipped (they
+/// belong to either cell).
+fn check_occupancy(c: &CompiledScene, cells: UVec3, what: &str) -> usize {
+    let mut g = c.clone();
+    g.use_grid(cells).expect("grid");
+    let grid = &g.grid().expect("a grid").grid;
+    let b = grid.bounds;
+    let size = b.extent() / grid.cells.as_vec3();
+    let mut checked = 0;
+    for (i, o) in c.objects.iter().enumerate() {
+        let points: Vec<Vec3> = match (&o.shape, &o.xf) {
+            (Shape::Sphere { center, radius }, None) => sphere_points(*center, *radius),
+            (Shape::Mesh(m), xf) => (0..m.triangle_count() as u32)
+                .flat_map(|k| triangle_points(m.triangle(k)))
+                .map(|p| {
+                    xf.as_ref()
+                        .map_or(p, |xf| xf.world_from_object.transform_point3(p))
+                })
+                .collect(),
+            (Shape::Triangle { vertices, .. }, xf) => triangle_points(*vertices)
+                .into_iter()
+                .map(|p| {
+                    xf.as_ref()
+                        .map_or(p, |xf| xf.world_from_object.transform_point3(p))
+                })
+                .collect(),
+            _ => continue,
+        };
+        for p in points {
+            let f = (p - b.min) / size;
+            let near_face = (f - f.round()).abs().min_element() < 1e-3;
+            if near_face || (f.cmplt(Vec3::ZERO) | f.cmpge(grid.cells.as_vec3())).any() {
+                continue;
+            }
+            let cell = f.floor().as_uvec3();
+            let holds = grid.entries(cell);
+            assert!(
+                !holds.is_empty(),
+                "{what}: a surface point of object {i} lies in empty cell {cell}"
+            );
+            checked += 1;
+        }
+    }
+    checked
+}
+
+#[test]
+fn every_surface_point_lies_in_an_occupied_cell_of_our_scenes() {
+    let mut points = 0;
+    for p in scene_files(&common::repo().join("scenes"))
+        .into_iter()
+        .filter(|p| !p.components().any(|c| c.as_os_str() == "perf"))
+    {
+        let Some(c) = compiled(&p) else { continue };
+        for cells in [UVec3::new(9, 7, 5), UVec3::splat(20)] {
+            points += check_occupancy(&c, cells, &p.display().to_string());
+        }
+    }
+    println!("{points} surface points in occupied cells");
+    assert!(points > 10_000, "{points}");
+}
+
+#[test]
+fn a_sphere_takes_only_the_cells_it_reaches_and_hostile_counts_are_refused() {
+    let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }\n\
+        Lights { numLights 0 }\nMaterials { numMaterials 1 Material { diffuseColor 1 0 0 } }\n\
+        Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n";
+    let (scene, _) =
+        tracelab_core::parse_scene(text.as_bytes(), "s.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("parses");
+    let mut c = CompiledScene::new(&scene);
+    c.use_grid(UVec3::splat(10)).expect("grid");
+    let g = &c.grid().expect("grid").grid;
+    // The box's 8 corner cells lie outside the sphere; the centre's cells inside it.
+    assert!(g.entries(UVec3::ZERO).is_empty());
+    assert!(g.entries(UVec3::splat(9)).is_empty());
+    assert!(!g.entries(UVec3::new(5, 5, 0)).is_empty());
+    let occupied = g.occupied();
+    assert!(occupied < 1000 && occupied > 400, "{occupied} of 1000");
+    let mut c = CompiledScene::new(&scene);
+    assert!(c.use_grid(UVec3::new(0, 1, 1)).is_err());
+    assert!(c.use_grid(UVec3::new(1 << 12, 1 << 12, 2)).is_err());
+    assert!(c.use_grid(UVec3::new(256, 256, 256)).is_ok());
+}
