@@ -17,13 +17,13 @@ use crate::document::op_target::{OpKind, OpTarget, op_target};
 use crate::gui::on_screen::OnScreen;
 
 /// Arm length on screen, in points.
-const ARM: f32 = 90.0;
+pub(crate) const ARM: f32 = 90.0;
 /// Where the scale squares sit along the arms, and where the arrows' shafts start.
 const SQUARE_AT: f32 = 0.45;
 const SHAFT_FROM: f32 = 0.62;
 const RING: f32 = 1.15;
 /// How near (points) the pointer must be to take a handle.
-const PICK: f32 = 7.0;
+pub(crate) const PICK: f32 = 7.0;
 
 /// Ctrl snaps translations to this step (in the op's own units) …
 pub const SNAP_LENGTH: f32 = 0.1;
@@ -180,14 +180,8 @@ impl Gizmo {
         let o = self.origin;
         for i in 0..3 {
             let a = self.move_axis(i);
-            if let (Some(p0), Some(p1)) = (
-                view.project(o + a * self.arm * SHAFT_FROM),
-                view.project(o + a * self.arm),
-            ) {
-                consider(
-                    segment_distance(pos, p0, p1 + (p1 - p0) * 0.3),
-                    Handle::Move(i),
-                );
+            if let Some(d) = arrow_distance(view, o, a, self.arm, pos) {
+                consider(d, Handle::Move(i));
             }
             if let Some(c) = view.project(o + self.scale.axis(i) * self.arm * SQUARE_AT) {
                 // The squares win over a shaft they overlap.
@@ -207,17 +201,7 @@ impl Gizmo {
 
     /// Draws the handles; `hot` is the one hovered or dragged.
     pub fn paint(&self, painter: &egui::Painter, view: &OnScreen, hot: Option<Handle>) {
-        let colour = |i: usize, h: Handle| {
-            if hot == Some(h) {
-                egui::Color32::from_rgb(255, 230, 60)
-            } else {
-                [
-                    egui::Color32::from_rgb(230, 60, 60),
-                    egui::Color32::from_rgb(80, 200, 80),
-                    egui::Color32::from_rgb(70, 120, 255),
-                ][i]
-            }
-        };
+        let colour = |i: usize, h: Handle| axis_colour(i, hot == Some(h));
         let o = self.origin;
         let Some(c) = view.project(o) else { return };
         let ring: Vec<egui::Pos2> = self
@@ -233,23 +217,7 @@ impl Gizmo {
         painter.add(egui::Shape::line(ring, egui::Stroke::new(2.0, ring_colour)));
         for i in 0..3 {
             let a = self.move_axis(i);
-            if let (Some(p0), Some(p1)) = (
-                view.project(o + a * self.arm * SHAFT_FROM),
-                view.project(o + a * self.arm),
-            ) {
-                let col = colour(i, Handle::Move(i));
-                painter.line_segment([p0, p1], egui::Stroke::new(2.5, col));
-                let d = (p1 - p0).normalized();
-                if d.is_finite() && (p1 - p0).length() > 4.0 {
-                    let n = egui::vec2(-d.y, d.x);
-                    let tip = p1 + d * 12.0;
-                    painter.add(egui::Shape::convex_polygon(
-                        vec![tip, p1 + n * 5.0, p1 - n * 5.0],
-                        col,
-                        egui::Stroke::NONE,
-                    ));
-                }
-            }
+            paint_arrow(painter, view, o, a, self.arm, colour(i, Handle::Move(i)));
             if let Some(q) = view.project(o + self.scale.axis(i) * self.arm * SQUARE_AT) {
                 let col = colour(i, Handle::Scale(i));
                 painter.rect_filled(
@@ -392,6 +360,61 @@ impl GizmoDrag {
     }
 }
 
+/// A handle's colour: x red, y green, z blue; yellow while hot.
+pub(crate) fn axis_colour(i: usize, hot: bool) -> egui::Color32 {
+    if hot {
+        egui::Color32::from_rgb(255, 230, 60)
+    } else {
+        [
+            egui::Color32::from_rgb(230, 60, 60),
+            egui::Color32::from_rgb(80, 200, 80),
+            egui::Color32::from_rgb(70, 120, 255),
+        ][i % 3]
+    }
+}
+
+/// How far (points) `pos` is from the translate arrow along unit `a` from `o`, `arm` world
+/// units long (its head counted in); `None` when the arrow is off screen.
+pub(crate) fn arrow_distance(
+    view: &OnScreen,
+    o: Vec3,
+    a: Vec3,
+    arm: f32,
+    pos: egui::Pos2,
+) -> Option<f32> {
+    let p0 = view.project(o + a * arm * SHAFT_FROM)?;
+    let p1 = view.project(o + a * arm)?;
+    Some(segment_distance(pos, p0, p1 + (p1 - p0) * 0.3))
+}
+
+/// Draws the translate arrow along unit `a` from `o`, `arm` world units long.
+pub(crate) fn paint_arrow(
+    painter: &egui::Painter,
+    view: &OnScreen,
+    o: Vec3,
+    a: Vec3,
+    arm: f32,
+    col: egui::Color32,
+) {
+    let (Some(p0), Some(p1)) = (
+        view.project(o + a * arm * SHAFT_FROM),
+        view.project(o + a * arm),
+    ) else {
+        return;
+    };
+    painter.line_segment([p0, p1], egui::Stroke::new(2.5, col));
+    let d = (p1 - p0).normalized();
+    if d.is_finite() && (p1 - p0).length() > 4.0 {
+        let n = egui::vec2(-d.y, d.x);
+        let tip = p1 + d * 12.0;
+        painter.add(egui::Shape::convex_polygon(
+            vec![tip, p1 + n * 5.0, p1 - n * 5.0],
+            col,
+            egui::Stroke::NONE,
+        ));
+    }
+}
+
 fn invert(m: &Mat4) -> Option<Mat4> {
     let d = m.determinant();
     (d.is_finite() && d.abs() > 1e-30).then(|| m.inverse())
@@ -402,7 +425,7 @@ fn wrap_degrees(d: f32) -> f32 {
 }
 
 /// The parameter along the line `o + s·a` (a unit) of its point nearest the ray.
-fn line_param(o: Vec3, a: Vec3, (ro, rd): (Vec3, Vec3)) -> Option<f32> {
+pub(crate) fn line_param(o: Vec3, a: Vec3, (ro, rd): (Vec3, Vec3)) -> Option<f32> {
     let rd = rd.normalize_or_zero();
     let b = a.dot(rd);
     let denom = 1.0 - b * b;

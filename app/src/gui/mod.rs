@@ -10,6 +10,7 @@ pub mod file_watch;
 pub mod gizmo;
 pub mod layout;
 pub mod lecture;
+pub mod light_gizmo;
 pub mod loading;
 pub mod menu;
 pub mod mesh_load;

@@ -1,10 +1,12 @@
 //! What the render view draws over the image besides the gizmo: the selected object's
-//! outline (from the per-pixel object ids that picking uses), a world-axes triad and the
-//! directional lights' directions.
+//! outline (from the per-pixel object ids that picking uses), a world-axes triad, the
+//! directional lights' directions and a marker at each point light.
 
 use glam::Vec3;
 use tracelab_core::{Frame, NodeId, Scene};
 
+use crate::document::Selection;
+use crate::gui::on_screen::OnScreen;
 use crate::navigation::ViewBasis;
 
 const OUTLINE: [u8; 4] = [255, 150, 20, 255];
@@ -100,15 +102,7 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
         let Some(d) = l.direction().and_then(tracelab_core::scene::unit) else {
             continue;
         };
-        let c = l.color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
-        let colour = egui::Color32::from_rgb(c.x as u8, c.y as u8, c.z as u8)
-            .gamma_multiply(0.5)
-            .to_opaque();
-        let colour = if colour.r().max(colour.g()).max(colour.b()) < 60 {
-            egui::Color32::LIGHT_GRAY
-        } else {
-            colour
-        };
+        let colour = light_colour(l.color);
         let o = rect.right_top() + egui::vec2(-34.0 - 60.0 * i as f32, 34.0);
         painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
         let v = on_screen(basis, d) * 20.0;
@@ -139,6 +133,56 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
             egui::FontId::proportional(10.0),
             colour,
         );
+    }
+}
+
+/// A small sun at each point light's position, in its colour, named; the selected one
+/// ringed (its arrows are the gizmo's).
+pub fn point_lights(
+    painter: &egui::Painter,
+    view: &OnScreen,
+    scene: &Scene,
+    selection: Option<Selection>,
+) {
+    for (i, l) in scene.lights().iter().enumerate() {
+        let tracelab_core::scene::LightKind::Point { position, .. } = l.kind else {
+            continue;
+        };
+        let Some(c) = view.project(position) else {
+            continue;
+        };
+        let colour = light_colour(l.color);
+        let stroke = egui::Stroke::new(1.5, colour);
+        painter.circle_filled(c, 5.0, colour);
+        painter.circle_stroke(c, 5.0, egui::Stroke::new(1.0, egui::Color32::BLACK));
+        for k in 0..8 {
+            let a = k as f32 * std::f32::consts::FRAC_PI_4;
+            let d = egui::vec2(a.cos(), a.sin());
+            painter.line_segment([c + d * 7.0, c + d * 11.0], stroke);
+        }
+        if selection == Some(Selection::Light(i)) {
+            painter.circle_stroke(c, 14.0, egui::Stroke::new(1.5, egui::Color32::WHITE));
+        }
+        painter.text(
+            c + egui::vec2(12.0, 10.0),
+            egui::Align2::LEFT_TOP,
+            format!("point light {i}"),
+            egui::FontId::proportional(10.0),
+            colour,
+        );
+    }
+}
+
+/// A light's colour for drawing: halved, and light grey where that would be too dark to see.
+fn light_colour(color: Vec3) -> egui::Color32 {
+    let c = color.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
+    let colour = egui::Color32::from_rgb(c.x as u8, c.y as u8, c.z as u8)
+        .gamma_multiply(0.5)
+        .to_opaque();
+    if colour.r().max(colour.g()).max(colour.b()) < 60 {
+        egui::Color32::LIGHT_GRAY
+    } else {
+        colour
     }
 }
 

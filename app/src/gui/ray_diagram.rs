@@ -3,7 +3,7 @@
 //! the screen. The Ray panel draws it; tests check its points against the ray story.
 
 use glam::{DMat4, Vec2, Vec3};
-use tracelab_core::render::RayStory;
+use tracelab_core::render::{RayKind, RayNode, RayStory};
 use tracelab_core::{Camera, MeshSlot, NodeKind, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,6 +20,26 @@ pub enum Role {
     Light,
     /// The object-space direction M⁻¹d, drawn from M⁻¹o with its own length.
     Direction,
+    /// A reflected ray of the pixel's ray tree (assignment 4), to its hit or, past a miss,
+    /// a stretch of its direction.
+    Reflected,
+    /// A refracted (transmitted) ray of the ray tree.
+    Refracted,
+    /// A shadow ray that reached its light (to a point light, or a stretch toward a
+    /// directional one).
+    Shadow,
+    /// A shadow ray stopped by an object: it ends at the blocker.
+    ShadowBlocked,
+}
+
+impl Role {
+    /// The roles the ray tree adds, in the legend's order, with their names there.
+    pub const TREE: [(Role, &'static str); 4] = [
+        (Role::Reflected, "reflected"),
+        (Role::Refracted, "refracted"),
+        (Role::Shadow, "shadow ray, reaches the light"),
+        (Role::ShadowBlocked, "shadow ray, blocked"),
+    ];
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -47,6 +67,8 @@ impl Item {
     fn fit_points(&self) -> Vec<Vec3> {
         match (self.role, &self.shape) {
             (Role::Eye, _) => Vec::new(),
+            // A light may be far off: the view fits where the rays start.
+            (Role::Shadow, Shape::Line(ps)) => ps.first().copied().into_iter().collect(),
             (Role::Ray, Shape::Line(ps)) => ps.last().copied().into_iter().collect(),
             _ => self.points(),
         }
@@ -246,6 +268,10 @@ pub fn diagrams(scene: &Scene, story: &RayStory) -> Option<(Diagram, Diagram)> {
         ));
     }
 
+    if let Some(tree) = &story.ray_tree {
+        world.items.extend(tree_items(tree, size_world * 1.5));
+    }
+
     let mut object = Diagram::default();
     let (o, d) = (h.object_ray.origin, h.object_ray.direction);
     object
@@ -280,6 +306,47 @@ pub fn diagrams(scene: &Scene, story: &RayStory) -> Option<(Diagram, Diagram)> {
         Some("n".into()),
     ));
     Some((world, object))
+}
+
+/// The ray tree's secondary rays and every shadow ray, in world space. The eye ray is the
+/// diagram's own `Role::Ray`; a ray that meets nothing, and a shadow ray toward a
+/// directional light, are drawn `stretch` long.
+pub fn tree_items(root: &RayNode, stretch: f32) -> Vec<Item> {
+    let mut items = Vec::new();
+    let mut stack = vec![root];
+    while let Some(node) = stack.pop() {
+        let role = match node.kind {
+            RayKind::Eye => None,
+            RayKind::Reflected => Some(Role::Reflected),
+            RayKind::Refracted => Some(Role::Refracted),
+        };
+        if let Some(role) = role {
+            let from = node.ray.origin;
+            let to = match node.hit {
+                Some((_, _, point, _)) => point,
+                None => from + node.ray.direction.normalize_or_zero() * stretch,
+            };
+            let label = (node.hit.is_none()).then(|| "misses".to_string());
+            items.push(Item::new(role, Shape::Line(vec![from, to]), label));
+        }
+        for sh in &node.shadows {
+            let dir = sh.ray.direction;
+            let along = |t: f32| sh.ray.origin + dir * t;
+            let (role, end) = match sh.blocker {
+                Some((t, _)) => (Role::ShadowBlocked, along(t)),
+                None if sh.distance.is_finite() => (Role::Shadow, along(sh.distance)),
+                None => (Role::Shadow, along(stretch / dir.length().max(1e-12))),
+            };
+            items.push(Item::new(
+                role,
+                Shape::Line(vec![sh.ray.origin, end]),
+                // Named at the first hit only: a deep tree's would hide the picture.
+                (node.kind == RayKind::Eye).then(|| format!("L{}", sh.light)),
+            ));
+        }
+        stack.extend(node.children.iter().rev());
+    }
+    items
 }
 
 /// An orbit view: yaw about +y, then pitch about the turned x axis, looking at a centre.

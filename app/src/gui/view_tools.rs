@@ -13,6 +13,7 @@ use crate::document::edit::Edit;
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::gizmo::{Axes, Gizmo, GizmoDrag, Handle};
+use crate::gui::light_gizmo::{LightDrag, LightGizmo};
 use crate::gui::on_screen::OnScreen;
 use crate::navigation::{self, ViewBasis};
 
@@ -31,6 +32,7 @@ enum Tool {
         depth: f32,
     },
     Gizmo(GizmoDrag),
+    Light(LightDrag),
 }
 
 struct Drag {
@@ -124,6 +126,14 @@ impl ViewTools {
         }
     }
 
+    /// The arrows of the selected point light in this view.
+    pub fn light_gizmo(doc: &Document, view: &OnScreen) -> Option<LightGizmo> {
+        match doc.selection {
+            Some(Selection::Light(i)) => LightGizmo::new(&doc.scene, i, view),
+            _ => None,
+        }
+    }
+
     /// Handles one image cell's pointer input. `surface` gives the world point shown at an
     /// image pixel (from the render on screen), if it shows one. Returns true when the
     /// pointer was used, so a click there is not also a pick.
@@ -140,6 +150,7 @@ impl ViewTools {
         out: &mut Vec<AppCommand>,
     ) -> bool {
         let gizmo = Self::gizmo(doc, view, axes);
+        let light_gizmo = Self::light_gizmo(doc, view);
         let (pos, press_origin, any_down, modifiers, esc) = ui.input(|i| {
             (
                 i.pointer.interact_pos(),
@@ -159,6 +170,13 @@ impl ViewTools {
         {
             self.hot = g.pick(view, p);
         }
+        if self.drag.is_none()
+            && !self.cancelled
+            && let (Some(g), Some(p)) = (&light_gizmo, pos)
+            && view.rect.contains(p)
+        {
+            self.hot = g.pick(view, p);
+        }
         let mut used = false;
         // A new drag.
         if self.drag.is_none() && !self.cancelled && resp.drag_started() {
@@ -168,10 +186,16 @@ impl ViewTools {
             let middle = resp.dragged_by(egui::PointerButton::Middle);
             let primary = resp.dragged_by(egui::PointerButton::Primary);
             let tool = if primary && !modifiers.alt {
+                let light = light_gizmo.as_ref().and_then(|g| {
+                    let l = doc.scene.lights().get(g.light)?;
+                    let h = g.pick(view, origin)?;
+                    g.grab(view, h, origin, l)
+                });
                 gizmo
                     .as_ref()
                     .and_then(|g| g.pick(view, origin).and_then(|h| g.grab(view, h, origin)))
                     .map(Tool::Gizmo)
+                    .or(light.map(Tool::Light))
             } else if (middle && modifiers.shift) || (primary && modifiers.alt && modifiers.shift) {
                 let depth = view
                     .basis
@@ -190,8 +214,10 @@ impl ViewTools {
                 None
             };
             if let Some(tool) = tool {
-                if let Tool::Gizmo(g) = &tool {
-                    self.hot = Some(g.handle);
+                match &tool {
+                    Tool::Gizmo(g) => self.hot = Some(g.handle),
+                    Tool::Light(g) => self.hot = Some(g.handle),
+                    _ => {}
                 }
                 self.drag = Some(Drag {
                     tool,
@@ -248,6 +274,14 @@ impl ViewTools {
                     Tool::Gizmo(g) => g
                         .value(view, p, modifiers.command)
                         .map(|op| Edit::SetOpOfKind { node: g.node, op }),
+                    // One undo step per drag: SetLight edits of one gesture coalesce.
+                    Tool::Light(g) => {
+                        g.value(view, p, modifiers.command)
+                            .map(|light| Edit::SetLight {
+                                index: g.light,
+                                light,
+                            })
+                    }
                 };
                 out.extend(edit.map(AppCommand::Edit));
             }

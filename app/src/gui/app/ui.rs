@@ -136,13 +136,18 @@ impl TracelabApp {
                 ui.close();
             }
             ui.separator();
-            ui.menu_button("Rays (assignments 3–4)", |ui| {
-                let mut rays = self.view.secondary;
-                rays_menu(ui, &mut rays);
-                if rays != self.view.secondary {
-                    out.push(AppCommand::SetRays(rays));
-                }
-            });
+            // Settings, not actions: a click on one keeps the submenu open for the next.
+            let keep_open = egui::containers::menu::MenuConfig::new()
+                .close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside);
+            egui::containers::menu::SubMenuButton::new("Rays (assignments 3–4)")
+                .config(keep_open)
+                .ui(ui, |ui| {
+                    let mut rays = self.view.secondary;
+                    rays_menu(ui, &mut rays);
+                    if rays != self.view.secondary {
+                        out.push(AppCommand::SetRays(rays));
+                    }
+                });
         });
     }
 

@@ -8,11 +8,13 @@ use tracelab_core::{
     Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
 };
 
-use crate::document::edit::{Edit, Refusal};
+use crate::document::edit::Edit;
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::drag_speed::{DragSpeeds, world_per_unit};
-use crate::gui::widgets::{number, render_from_swatch, swatch_from_render};
+use crate::gui::widgets::number;
+
+use super::fields::{color, op_id, refusal_note, scalar, show_refusal_for, vec3};
 
 pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
     let mut edits = Vec::new();
@@ -65,6 +67,8 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
             Some(Selection::Materials) => {
                 ui.heading("Materials");
                 for i in 0..doc.scene.materials.len() {
+                    ui.separator();
+                    ui.strong(format!("Material {i}"));
                     material(ui, doc, i, &mut edits);
                 }
                 if ui.button("Add material").clicked() {
@@ -82,134 +86,6 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
         .map(AppCommand::Edit)
         .chain(asked)
         .collect()
-}
-
-/// Three drag values labelled for screen readers and tests (e.g. "Translate x").
-pub fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
-    let mut changed = false;
-    ui.horizontal(|ui| {
-        ui.label(name);
-        for (axis, c) in [("x", &mut v.x), ("y", &mut v.y), ("z", &mut v.z)] {
-            let r = number(ui, &mut *c, |d| d.speed(speed).max_decimals(4));
-            name_widget(&r, format!("{name} {axis}"), f64::from(*c));
-            changed |= r.changed();
-        }
-    });
-    // Under the row, not beside it: the row's width is taken, and a wrapped reason one word
-    // a line is hard to read.
-    refusal_note(ui, name);
-    changed
-}
-
-/// Gives a drag value an accessible name (screen readers, and tests that find it by label).
-fn name_widget(r: &egui::Response, name: String, value: f64) {
-    r.widget_info(|| egui::WidgetInfo {
-        label: Some(name.clone()),
-        ..egui::WidgetInfo::drag_value(true, value)
-    });
-}
-
-fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
-    let changed = ui
-        .horizontal(|ui| {
-            ui.label(name);
-            let r = number(ui, &mut *v, |d| d.speed(speed).max_decimals(4));
-            name_widget(&r, name.to_string(), f64::from(*v));
-            r.changed()
-        })
-        .inner;
-    refusal_note(ui, name);
-    changed
-}
-
-/// What the last refused edit said, while the inspector draws the place it was about. In
-/// egui's memory for the frame, so `vec3`, `scalar` and `color` show it beside the field it
-/// names without a parameter each.
-#[derive(Clone)]
-struct Note {
-    field: String,
-    op: Option<usize>,
-    reason: String,
-}
-
-fn note_id() -> egui::Id {
-    egui::Id::unique("tracelab-refusal-note")
-}
-
-/// The op being drawn, so a refusal for op 2 shows beside op 2's fields only.
-fn op_id() -> egui::Id {
-    egui::Id::unique("tracelab-refusal-op")
-}
-
-fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Place>) {
-    let note = doc
-        .refusal
-        .as_ref()
-        .filter(|r: &&Refusal| r.place.is_some() && r.place == place)
-        .map(|r| Note {
-            field: r.field.clone(),
-            op: r.op,
-            reason: r.reason.clone(),
-        });
-    ui.data_mut(|d| {
-        d.insert_temp(note_id(), note);
-        d.insert_temp(op_id(), None::<usize>);
-    });
-}
-
-/// Whether the widget labelled `label` edits the file's field `field` ("angle (degrees)"
-/// edits "angle", "Rotate axis" edits "Rotate", "colour" edits "color").
-fn same_field(label: &str, field: &str) -> bool {
-    let label = label.split(" (").next().unwrap_or(label);
-    label == field
-        || label
-            .strip_prefix(field)
-            .is_some_and(|rest| rest.starts_with(' '))
-        || matches!(
-            (label, field),
-            ("colour", "color") | ("ambient light", "ambientLight")
-        )
-        || (label.ends_with(": diffuse") && field == "diffuseColor")
-}
-
-fn refusal_note(ui: &mut egui::Ui, label: &str) {
-    let (note, op) = ui.data(|d| {
-        (
-            d.get_temp::<Option<Note>>(note_id()).flatten(),
-            d.get_temp::<Option<usize>>(op_id()).flatten(),
-        )
-    });
-    if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
-        // Wrapped to the panel: a long reason must not widen it.
-        ui.add(
-            egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color))
-                .wrap(),
-        );
-    }
-}
-
-fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
-    let changed = ui
-        .horizontal(|ui| {
-            ui.label(name);
-            let mut rgb = c.to_array();
-            // The swatch in the render's colour space (see `swatch_from_render`).
-            let mut swatch = swatch_from_render(rgb);
-            let changed = ui.color_edit_button_rgb(&mut swatch).changed();
-            if changed {
-                rgb = render_from_swatch(swatch);
-            }
-            let mut changed2 = false;
-            for v in &mut rgb {
-                changed2 |=
-                    number(ui, v, |d| d.speed(0.005).range(0.0..=4.0).max_decimals(3)).changed();
-            }
-            *c = Vec3::from_array(rgb);
-            changed || changed2
-        })
-        .inner;
-    refusal_note(ui, name);
-    changed
 }
 
 fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
@@ -338,23 +214,28 @@ fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) 
     };
     let mut m = m.clone();
     show_refusal_for(ui, doc, Some(Place::Material(i)));
-    // Remove under the colour, not beside it: beside, the row was wider than the panel and
-    // egui widened the inspector by 60 points, pushing the picture aside.
-    let mut c = m.diffuse;
-    if color(ui, &format!("{i}: diffuse"), &mut c) {
-        m.diffuse = c;
-        edits.push(Edit::SetMaterial {
-            index: i,
-            material: m.clone(),
-        });
-    }
-    if ui
-        .button("Remove")
-        .on_hover_text(format!("Remove material {i}"))
-        .clicked()
-    {
-        edits.push(Edit::RemoveMaterial { index: i });
-    }
+    ui.push_id(("material", i), |ui| {
+        // Remove under the colour, not beside it: beside, the row was wider than the panel
+        // and egui widened the inspector by 60 points, pushing the picture aside.
+        let mut c = m.diffuse;
+        if color(ui, &format!("{i}: diffuse"), &mut c) {
+            m.diffuse = c;
+            edits.push(Edit::SetMaterial {
+                index: i,
+                material: m.clone(),
+            });
+        }
+        if let Some(material) = super::phong::fields(ui, &m) {
+            edits.push(Edit::SetMaterial { index: i, material });
+        }
+        if ui
+            .button("Remove")
+            .on_hover_text(format!("Remove material {i}"))
+            .clicked()
+        {
+            edits.push(Edit::RemoveMaterial { index: i });
+        }
+    });
 }
 
 fn node(

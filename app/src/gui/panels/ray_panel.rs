@@ -1,7 +1,9 @@
 //! The Ray panel: the picked pixel's ray drawn twice, as the lecture's "World Space / Object
 //! Space" figure — in world space with the hit object, both normals, the tangent plane and
 //! the lights; in the hit primitive's own space with M⁻¹o, M⁻¹d at its own length and the
-//! object normal. Drag in either diagram to orbit it.
+//! object normal. Drag in either diagram to orbit it. With shadows or bounces on, the world
+//! diagram also draws the pixel's ray tree: reflected and refracted rays and the shadow
+//! rays, with a legend.
 
 use egui::{Color32, Pos2, Stroke};
 use glam::{Vec2, Vec3};
@@ -21,6 +23,58 @@ fn color(role: Role) -> Color32 {
         Role::Tangent => Color32::from_rgba_unmultiplied(90, 220, 90, 90),
         Role::Light => Color32::from_rgb(255, 190, 60),
         Role::Direction => Color32::from_rgb(255, 140, 255),
+        Role::Reflected => Color32::from_rgb(80, 200, 255),
+        Role::Refracted => Color32::from_rgb(200, 120, 255),
+        Role::Shadow => Color32::from_rgb(170, 170, 140),
+        Role::ShadowBlocked => Color32::from_rgb(255, 70, 70),
+    }
+}
+
+/// A line of the diagram: shadow rays thin and dashed, the others solid.
+fn line(painter: &egui::Painter, role: Role, pts: Vec<Pos2>) {
+    let c = color(role);
+    match role {
+        Role::Shadow | Role::ShadowBlocked => {
+            painter.extend(egui::Shape::dashed_line(
+                &pts,
+                Stroke::new(1.0, c),
+                5.0,
+                3.0,
+            ));
+        }
+        Role::Ray | Role::Reflected | Role::Refracted => {
+            painter.line(pts, Stroke::new(2.0, c));
+        }
+        _ => {
+            painter.line(pts, Stroke::new(1.0, c));
+        }
+    }
+}
+
+/// The ray tree's colours, top left, for the roles the diagram holds.
+fn legend(painter: &egui::Painter, rect: egui::Rect, d: &Diagram) {
+    let mut at = rect.left_top() + egui::vec2(8.0, 8.0);
+    let shown: Vec<(Role, &str)> = std::iter::once((Role::Ray, "eye ray"))
+        .chain(Role::TREE)
+        .filter(|(r, _)| d.find(*r).next().is_some())
+        .collect();
+    if shown.len() < 2 {
+        return;
+    }
+    for (role, name) in shown {
+        line(
+            painter,
+            role,
+            vec![at + egui::vec2(0.0, 6.0), at + egui::vec2(22.0, 6.0)],
+        );
+        painter.text(
+            at + egui::vec2(28.0, 0.0),
+            egui::Align2::LEFT_TOP,
+            name,
+            egui::FontId::proportional(11.0),
+            color(role),
+        );
+        at.y += 14.0;
     }
 }
 
@@ -63,9 +117,21 @@ fn draw(
                     proj(*p)
                 }
                 Shape::Line(ps) => {
-                    let width = if item.role == Role::Ray { 2.0 } else { 1.0 };
-                    painter.line(ps.iter().map(|p| proj(*p)).collect(), Stroke::new(width, c));
-                    ps.last().map_or(Pos2::ZERO, |p| proj(*p))
+                    line(&painter, item.role, ps.iter().map(|p| proj(*p)).collect());
+                    let end = ps.last().map_or(Pos2::ZERO, |p| proj(*p));
+                    if item.role == Role::ShadowBlocked {
+                        // A cross where the blocker stopped it.
+                        let s = Stroke::new(1.5, c);
+                        painter.line_segment(
+                            [end - egui::vec2(4.0, 4.0), end + egui::vec2(4.0, 4.0)],
+                            s,
+                        );
+                        painter.line_segment(
+                            [end - egui::vec2(4.0, -4.0), end + egui::vec2(4.0, -4.0)],
+                            s,
+                        );
+                    }
+                    end
                 }
                 Shape::Arrow(a, b) => {
                     let (pa, pb) = (proj(*a), proj(*b));
@@ -83,6 +149,7 @@ fn draw(
                 );
             }
         }
+        legend(&painter, rect, d);
         // Say where the origin is when it lies outside the view.
         if let Some(o) = d.items.iter().find(|i| i.role == Role::Eye)
             && let Shape::Point(p) = o.shape

@@ -2,7 +2,7 @@
 //! a UI), then drawn; clicks and toolbar buttons become commands (selections and [`Edit`]s).
 
 use glam::Vec3;
-use tracelab_core::scene::Walk;
+use tracelab_core::scene::{LightKind, Walk};
 use tracelab_core::{CsgOp, MeshSlot, NodeId, NodeKind, Scene, TransformOp};
 
 use crate::document::edit::Edit;
@@ -81,10 +81,15 @@ pub fn ui(
             Selection::Lights,
             format!("Lights ({})", doc.scene.lights().len()),
         );
-        for i in 0..doc.scene.lights().len() {
+        for (i, l) in doc.scene.lights().iter().enumerate() {
+            // Point lights named apart: the gizmo moves them, a direction has no place.
+            let label = match l.kind {
+                LightKind::Point { .. } => format!("Point light {i}"),
+                LightKind::Directional { .. } => format!("Light {i}"),
+            };
             ui.horizontal(|ui| {
                 ui.add_space(14.0);
-                item(ui, Selection::Light(i), format!("Light {i}"));
+                item(ui, Selection::Light(i), label);
             });
         }
         item(ui, Selection::Background, "Background".into());

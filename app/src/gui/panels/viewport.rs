@@ -447,6 +447,10 @@ impl Viewport {
                     if let Some(g) = ViewTools::gizmo(doc, &view, s.gizmo_axes) {
                         g.paint(&painter, &view, self.tools.hot);
                     }
+                    overlays::point_lights(&painter, &view, &doc.scene, doc.selection);
+                    if let Some(g) = ViewTools::light_gizmo(doc, &view) {
+                        g.paint(&painter, &view, self.tools.hot);
+                    }
                 }
                 if let Some((mx, my)) = self.marker {
                     let c = rect.min
