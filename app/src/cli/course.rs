@@ -7,13 +7,9 @@ use tracelab_core::render::Secondary;
 use tracelab_core::{NormalTransform, ObjectRays};
 
 use super::render::RenderJob;
-use super::values::{parse_count, parse_f32, parse_u32};
+use super::values::{MAX_BOUNCES, parse_count, parse_f32, parse_u32};
 use crate::exit::usage;
 use crate::io::write_stderr_text;
-
-/// The most levels of secondary rays `-bounces` takes: deeper than any course scene needs
-/// (10), and shallow enough that the recursion stays well inside a thread's stack.
-pub const MAX_BOUNCES: u32 = 100;
 
 /// Flags of the course's later weeks that tracelab does not implement yet: refused by name,
 /// never ignored (an image made without them would be silently wrong).

@@ -65,10 +65,10 @@ pub struct SecondaryArgs {
 impl SecondaryArgs {
     /// The secondary-ray settings, checked as the course form checks them.
     pub fn secondary(&self) -> anyhow::Result<Secondary> {
-        if self.bounces > super::course::MAX_BOUNCES {
+        if self.bounces > super::values::MAX_BOUNCES {
             return Err(usage(format!(
                 "--bounces: at most {} levels, found {}",
-                super::course::MAX_BOUNCES,
+                super::values::MAX_BOUNCES,
                 self.bounces
             )));
         }

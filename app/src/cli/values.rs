@@ -4,6 +4,10 @@ use std::ffi::OsStr;
 
 use crate::exit::usage;
 
+/// The most levels of secondary rays `-bounces` takes: deeper than any course scene needs
+/// (10), and shallow enough that the recursion stays well inside a thread's stack.
+pub const MAX_BOUNCES: u32 = 100;
+
 pub(super) fn parse_f32(s: &OsStr, what: &str) -> anyhow::Result<f32> {
     s.to_str()
         .and_then(|t| t.parse::<f32>().ok())
