@@ -180,8 +180,10 @@ fn the_correct_images_are_accepted_with_no_diagnosis() {
 fn diff_names_exactly_the_mistake_each_variant_makes() {
     let mut failures = Vec::new();
     for m in Mistake::ALL {
-        if m == Mistake::Rounding {
-            continue; // within 1/255 everywhere: see the test below.
+        if m == Mistake::Rounding || Mistake::ASSIGNMENTS_3_4.contains(&m) {
+            // Rounding: within 1/255 everywhere (see the test below); assignments 3-4's
+            // mistakes need highlights or secondary rays: app/tests/oracle_semester.rs.
+            continue;
         }
         let (what, scene, shade_back) = case(m);
         let text = scene();

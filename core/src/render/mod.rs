@@ -15,6 +15,7 @@ mod occlusion;
 mod plan;
 mod progressive;
 mod rule_gap;
+mod rules;
 mod shade;
 mod shade_lanes;
 mod similitude;
@@ -31,6 +32,7 @@ pub use object_rays::{ObjectRays, ObjectT};
 pub use plan::{Cancel, Cancelled, Passes, RenderPlan, Tracing, Uncancellable};
 pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_frame};
 pub use rule_gap::{NormalGap, normal_rule_gap};
+pub use rules::{Ambient, Rules};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use whitted::{

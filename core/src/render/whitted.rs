@@ -20,6 +20,7 @@ use glam::Vec3;
 use super::RenderSettings;
 use super::compile::{CompiledScene, Hit};
 use super::grid_scene::RayCounts;
+use super::rules::{Ambient, Rules};
 use crate::geometry::Ray;
 use crate::scene::Phong;
 
@@ -170,12 +171,34 @@ pub(super) fn shade_primary(
         &at_hit,
         hit,
         normal,
-        s,
+        (s, &Rules::COURSE),
         s.secondary.bounces,
         1.0,
         &mut NoRecord,
     );
     (c, normal)
+}
+
+/// An eye ray's colour under `rules` (the mistake catalogue's variants): `at_hit` the ray
+/// whose `at(hit.t)` is the hit point, `normal` the world normal the variant computed.
+pub(super) fn shade_with_rules(
+    scene: &CompiledScene,
+    at_hit: &Ray,
+    hit: &Hit,
+    normal: Vec3,
+    s: &RenderSettings,
+    rules: &Rules,
+) -> Vec3 {
+    color_at(
+        scene,
+        at_hit,
+        hit,
+        normal,
+        (s, rules),
+        s.secondary.bounces,
+        1.0,
+        &mut NoRecord,
+    )
 }
 
 /// An eye ray's whole ray tree: every shadow, reflected and refracted ray the render traces
@@ -197,7 +220,7 @@ pub fn ray_tree(scene: &CompiledScene, ray: &Ray, s: &RenderSettings) -> RayNode
                 &at_hit,
                 &hit,
                 normal,
-                s,
+                (s, &Rules::COURSE),
                 s.secondary.bounces,
                 1.0,
                 &mut root,
@@ -360,7 +383,7 @@ fn trace<R: Record>(
     ray: &Ray,
     bounces: u32,
     weight: f32,
-    s: &RenderSettings,
+    (s, rules): (&RenderSettings, &Rules),
     rec: &mut R,
 ) -> Vec3 {
     if let Some(g) = scene.grid() {
@@ -371,7 +394,7 @@ fn trace<R: Record>(
         Some(hit) => {
             let normal = scene.world_normal(ray, &hit, s.normal_transform);
             rec.hit(scene, ray, &hit, normal);
-            color_at(scene, ray, &hit, normal, s, bounces, weight, rec)
+            color_at(scene, ray, &hit, normal, (s, rules), bounces, weight, rec)
         }
     };
     rec.color(c);
@@ -385,7 +408,7 @@ fn color_at<R: Record>(
     ray: &Ray,
     hit: &Hit,
     normal: Vec3,
-    s: &RenderSettings,
+    (s, rules): (&RenderSettings, &Rules),
     bounces: u32,
     weight: f32,
     rec: &mut R,
@@ -393,21 +416,45 @@ fn color_at<R: Record>(
     let kd = scene.hit_color(hit);
     let m = scene.hit_phong(hit);
     let mut n = normal;
-    if ray.direction.dot(normal) > 0.0 {
-        if !s.shade_back {
+    let back = ray.direction.dot(normal) > 0.0;
+    let absolute = back && s.shade_back && rules.shade_back_absolute;
+    if back && !absolute {
+        if s.shade_back || rules.back_faces_flipped {
+            n = -normal;
+        } else if !rules.back_faces_lit {
             // As in assignment 2: a back face is black without -shade_back.
             return Vec3::ZERO;
         }
-        n = -normal;
     }
     let p = ray.at(hit.t);
     let d = ray.direction.normalize_or_zero();
-    let mut c = scene.ambient * kd;
-    rec.ambient(c);
-    let at = Surface { p, n, d, kd, m: &m };
+    let ambient = match rules.ambient {
+        Ambient::TimesDiffuse => scene.ambient * kd,
+        Ambient::Plain => scene.ambient,
+        Ambient::TimesDiffuseTwice => scene.ambient * kd * kd,
+    };
+    // The mistake adds the ambient term last, once it knows whether a light was blocked.
+    let mut c = if rules.ambient_dropped_in_shadow {
+        Vec3::ZERO
+    } else {
+        ambient
+    };
+    rec.ambient(ambient);
+    let at = Surface {
+        p,
+        n,
+        d,
+        kd,
+        m: &m,
+        absolute,
+    };
+    let mut shadowed = false;
     for (k, &(l, color)) in scene.lights.iter().enumerate() {
         let i = scene.light_index(k);
-        c += light_term(scene, &at, (i, l, color, f32::INFINITY), s, rec);
+        let (share, blocked) =
+            light_term(scene, &at, (i, l, color, f32::INFINITY), (s, rules), rec);
+        c += share;
+        shadowed |= blocked;
     }
     for (k, pl) in scene.point_lights.iter().enumerate() {
         let i = scene.light_index(scene.lights.len() + k);
@@ -418,7 +465,12 @@ fn color_at<R: Record>(
         };
         let a = pl.attenuation;
         let color = pl.color / (a.x + a.y * dist + a.z * dist * dist);
-        c += light_term(scene, &at, (i, l, color, dist), s, rec);
+        let (share, blocked) = light_term(scene, &at, (i, l, color, dist), (s, rules), rec);
+        c += share;
+        shadowed |= blocked;
+    }
+    if rules.ambient_dropped_in_shadow && !shadowed {
+        c += ambient;
     }
     for (kind, factor) in [
         (RayKind::Reflected, m.reflective),
@@ -432,7 +484,7 @@ fn color_at<R: Record>(
             continue;
         }
         let w = weight * factor.length();
-        if w < s.secondary.weight {
+        if w < s.secondary.weight && !rules.weight_ignored {
             rec.cut(kind, Cut::Weight { weight: w });
             continue;
         }
@@ -442,10 +494,16 @@ fn color_at<R: Record>(
             // Entering or leaving by the side the ray meets, whatever shade-back did to n.
             let (outward, n_i, n_t) = if d.dot(normal) < 0.0 {
                 (normal, 1.0, m.index_of_refraction)
+            } else if rules.index_not_inverted {
+                (-normal, 1.0, m.index_of_refraction)
             } else {
                 (-normal, m.index_of_refraction, 1.0)
             };
-            transmitted(outward, d, n_i, n_t)
+            transmitted(outward, d, n_i, n_t).or_else(|| {
+                rules
+                    .tir_transmits_reflected
+                    .then(|| (d - 2.0 * outward.dot(d) * outward).normalize_or_zero())
+            })
         };
         let Some(dir) = dir else {
             rec.cut(kind, Cut::TotalInternalReflection);
@@ -453,7 +511,7 @@ fn color_at<R: Record>(
         };
         let next = Ray::new(p, dir);
         let child = rec.child(kind, &next, w, factor);
-        c += factor * trace(scene, &next, bounces - 1, w, s, child);
+        c += factor * trace(scene, &next, bounces - 1, w, (s, rules), child);
     }
     c
 }
@@ -466,66 +524,112 @@ struct Surface<'a> {
     d: Vec3,
     kd: Vec3,
     m: &'a Phong,
+    /// -shade_back's |L·N| mistake on a back face.
+    absolute: bool,
 }
 
 /// One light's diffuse and specular share at `at`: (its index, unit direction toward it, its
 /// colour there, distance to it — infinite for a directional light); zero in its shadow.
+/// Also whether a shadow ray was blocked.
 #[inline]
 fn light_term<R: Record>(
     scene: &CompiledScene,
     at: &Surface,
     (i, l, color, dist): (usize, Vec3, Vec3, f32),
-    s: &RenderSettings,
+    (s, rules): (&RenderSettings, &Rules),
     rec: &mut R,
-) -> Vec3 {
-    let Surface { p, n, d, kd, m } = *at;
-    let nl = l.dot(n);
+) -> (Vec3, bool) {
+    let Surface {
+        p,
+        n,
+        d,
+        kd,
+        m,
+        absolute,
+    } = *at;
+    let nl = if absolute { l.dot(n).abs() } else { l.dot(n) };
+    let behind_highlight = rules.specular_behind && m.specular != Vec3::ZERO;
     // Nothing lights a point from behind its surface, so no shadow ray is needed there.
-    if nl <= 0.0 {
+    if nl <= 0.0 && !behind_highlight {
         rec.light(i, Vec3::ZERO);
-        return Vec3::ZERO;
+        return (Vec3::ZERO, false);
     }
     if s.secondary.shadows {
         if let Some(g) = scene.grid() {
             RayCounts::add(&g.stats.shadow_rays, 1);
         }
         let shadow = Ray::new(p, l);
+        let t_min = if rules.shadow_t_min_zero {
+            0.0
+        } else {
+            SECONDARY_T_MIN
+        };
         let blocked = if R::WANTS_BLOCKER {
-            let b = scene.intersect(&shadow, SECONDARY_T_MIN, dist);
+            let b = scene.intersect(&shadow, t_min, dist);
             rec.shadow(i, &shadow, dist, b.map(|h| (h.t, scene.hit_node(&h))));
             b.is_some()
+        } else if rules.transparent_casts_no_shadow {
+            opaque_blocker(scene, &shadow, t_min, dist)
         } else {
-            blocked(scene, &shadow, dist, s.secondary.shadow_query)
+            blocked(scene, &shadow, t_min, dist, s.secondary.shadow_query)
         };
         if blocked {
             rec.light(i, Vec3::ZERO);
-            return Vec3::ZERO;
+            return (Vec3::ZERO, true);
         }
     }
     // The same operations, in the same order, as `shade.rs`'s diffuse term.
     let mut c = nl.max(0.0) * color * kd;
     if m.specular != Vec3::ZERO {
-        let h = (l - d).normalize_or_zero();
-        let highlight = n.dot(h).max(0.0).powf(m.exponent);
+        let highlight = if rules.reflection_vector {
+            // Phong: the light's mirror direction against the direction to the eye.
+            let r = 2.0 * n.dot(l) * n - l;
+            r.dot(-d).max(0.0).powf(m.exponent)
+        } else {
+            let h = (l - d).normalize_or_zero();
+            n.dot(h).max(0.0).powf(m.exponent)
+        };
         let spec = if s.secondary.specular_fix {
-            m.specular * highlight * nl
+            // nl > 0 here unless a mistake keeps the highlight behind the surface.
+            m.specular * highlight * nl.max(0.0)
         } else {
             m.specular * highlight
         };
         c += color * spec;
     }
     rec.light(i, c);
-    c
+    (c, false)
 }
 
 /// Whether anything lies on the shadow ray before the light: the any-hit query, which stops
 /// at the first blocker it finds (the same answer as a closest hit, tested bit for bit).
 #[inline]
-fn blocked(scene: &CompiledScene, shadow: &Ray, dist: f32, query: ShadowQuery) -> bool {
+fn blocked(scene: &CompiledScene, shadow: &Ray, t_min: f32, dist: f32, query: ShadowQuery) -> bool {
     match query {
-        ShadowQuery::AnyHit => scene.occluded(shadow, SECONDARY_T_MIN, dist),
-        ShadowQuery::ClosestHit => scene.intersect(shadow, SECONDARY_T_MIN, dist).is_some(),
+        ShadowQuery::AnyHit => scene.occluded(shadow, t_min, dist),
+        ShadowQuery::ClosestHit => scene.intersect(shadow, t_min, dist).is_some(),
     }
+}
+
+/// The most transparent surfaces a shadow ray of the no-transparent-shadow mistake steps
+/// through before it counts as unblocked (a guard against a degenerate loop).
+const MAX_TRANSPARENT_STEPS: usize = 64;
+
+/// Whether an opaque object lies on the shadow ray before the light, stepping through
+/// transparent ones (the mistake `transparent-casts-no-shadow`; the course's shadow rays stop
+/// at anything).
+fn opaque_blocker(scene: &CompiledScene, shadow: &Ray, t_min: f32, dist: f32) -> bool {
+    let mut from = t_min;
+    for _ in 0..MAX_TRANSPARENT_STEPS {
+        let Some(h) = scene.intersect(shadow, from, dist) else {
+            return false;
+        };
+        if scene.hit_phong(&h).transparent == Vec3::ZERO {
+            return true;
+        }
+        from = h.t + SECONDARY_T_MIN;
+    }
+    false
 }
 
 /// The handout's `transmittedDirection`: `d` (unit) crossing from index `n_i` into `n_t`

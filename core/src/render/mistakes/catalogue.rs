@@ -1,20 +1,12 @@
-//! The catalogue of known student mistakes, each a render variant: what a ray tracer that
-//! breaks one of the course's rules draws, so `tracelab diff` can name the rule a student's
-//! image breaks. A variant is one or two mistakes at once; with none (`RenderSettings::variant`
-//! = `None`) nothing here runs and the render is today's, bit for bit.
-//!
-//! The variant renderer traces one ray per pixel through the same intersection, normal and
-//! material code as the renderer, changing only what each mistake changes, so a variant
-//! differs from the reference exactly where the mistake shows.
+//! The catalogue itself: each mistake's name, what it draws, the course rule it breaks, the
+//! images it can change and a cheap test of whether it can change a given picture.
 
-use glam::{Mat4, Vec3};
-use rayon::prelude::*;
+use glam::Vec3;
 
-use super::compile::{CompiledScene, Hit, Shape};
-use super::frame::{Frame, Sample, View, depth_shade, quantize};
-use super::{NormalTransform, ObjectRays, RenderSettings};
-use crate::geometry::Ray;
-use crate::scene::{NodeKind, Scene, TransformOp};
+use super::transforms::course_parser_scene;
+use crate::render::compile::CompiledScene;
+use crate::render::{NormalTransform, ObjectRays, RenderSettings};
+use crate::scene::Scene;
 
 /// One known mistake. The order is the catalogue's (and the order diagnoses list ties in).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -36,6 +28,15 @@ pub enum Mistake {
     BackgroundNotBlack,
     MatrixCourseSide,
     RotateAxisAsWritten,
+    // Assignments 3 and 4.
+    ReflectionVector,
+    SpecularBehind,
+    ShadowAcne,
+    AmbientDroppedInShadow,
+    TransparentCastsNoShadow,
+    IndexNotInverted,
+    TotalInternalReflectionTransmitted,
+    WeightIgnored,
 }
 
 /// Which images a mistake can change.
@@ -47,7 +48,7 @@ pub struct Views {
 }
 
 impl Mistake {
-    pub const ALL: [Mistake; 17] = [
+    pub const ALL: [Mistake; 25] = [
         Mistake::PixelCorners,
         Mistake::AngleInterpolated,
         Mistake::RowsFlipped,
@@ -65,6 +66,27 @@ impl Mistake {
         Mistake::BackgroundNotBlack,
         Mistake::MatrixCourseSide,
         Mistake::RotateAxisAsWritten,
+        Mistake::ReflectionVector,
+        Mistake::SpecularBehind,
+        Mistake::ShadowAcne,
+        Mistake::AmbientDroppedInShadow,
+        Mistake::TransparentCastsNoShadow,
+        Mistake::IndexNotInverted,
+        Mistake::TotalInternalReflectionTransmitted,
+        Mistake::WeightIgnored,
+    ];
+
+    /// The mistakes of assignments 3 and 4 (Phong, shadows, reflection, refraction): they
+    /// change only pictures with highlights, shadow rays or secondary rays.
+    pub const ASSIGNMENTS_3_4: [Mistake; 8] = [
+        Mistake::ReflectionVector,
+        Mistake::SpecularBehind,
+        Mistake::ShadowAcne,
+        Mistake::AmbientDroppedInShadow,
+        Mistake::TransparentCastsNoShadow,
+        Mistake::IndexNotInverted,
+        Mistake::TotalInternalReflectionTransmitted,
+        Mistake::WeightIgnored,
     ];
 
     fn bit(self) -> u32 {
@@ -91,6 +113,14 @@ impl Mistake {
             Mistake::BackgroundNotBlack => "background-not-black",
             Mistake::MatrixCourseSide => "matrix-course-side",
             Mistake::RotateAxisAsWritten => "rotate-axis-as-written",
+            Mistake::ReflectionVector => "reflection-vector",
+            Mistake::SpecularBehind => "specular-behind",
+            Mistake::ShadowAcne => "shadow-acne",
+            Mistake::AmbientDroppedInShadow => "ambient-dropped-in-shadow",
+            Mistake::TransparentCastsNoShadow => "transparent-casts-no-shadow",
+            Mistake::IndexNotInverted => "index-not-inverted",
+            Mistake::TotalInternalReflectionTransmitted => "tir-transmitted",
+            Mistake::WeightIgnored => "weight-ignored",
         }
     }
 
@@ -138,6 +168,30 @@ impl Mistake {
             Mistake::RotateAxisAsWritten => {
                 "Rotate { } with its axis as written, not normalised (as the course parser does)"
             }
+            Mistake::ReflectionVector => {
+                "the highlight as Phong's (R·V)^e, R the light's mirror direction, instead of Blinn's (N·H)^e"
+            }
+            Mistake::SpecularBehind => {
+                "the specular term kept where N·L ≤ 0 (highlights on the side facing away from the light)"
+            }
+            Mistake::ShadowAcne => {
+                "shadow rays start at t_min 0: a surface shadows itself in speckles (shadow acne)"
+            }
+            Mistake::AmbientDroppedInShadow => {
+                "the ambient term dropped where a shadow ray is blocked (shadows drawn black)"
+            }
+            Mistake::TransparentCastsNoShadow => {
+                "shadow rays pass through transparent objects (they cast no shadow)"
+            }
+            Mistake::IndexNotInverted => {
+                "refraction always from index 1 into n: the index not inverted when the ray leaves"
+            }
+            Mistake::TotalInternalReflectionTransmitted => {
+                "on total internal reflection the transmitted ray is traced along the mirror direction (times the transparent colour) instead of none"
+            }
+            Mistake::WeightIgnored => {
+                "-weight ignored: rays whose weight is below the cut-off are traced"
+            }
         }
     }
 
@@ -183,6 +237,28 @@ impl Mistake {
             Mistake::RotateAxisAsWritten => {
                 "tracelab normalises Rotate's axis; the course parser does not (a rotation and a scale)"
             }
+            Mistake::ReflectionVector => {
+                "the handout's Blinn-Torrance highlight: k_s·(N·H)^e with H = normalize(L − d)"
+            }
+            Mistake::SpecularBehind => {
+                "the specular term is 0 where N·L ≤ 0 (or, with the optional fix, times max(N·L, 0))"
+            }
+            Mistake::ShadowAcne => "a shadow ray starts at the hit point with t_min = epsilon",
+            Mistake::AmbientDroppedInShadow => {
+                "in shadow only the light's diffuse and specular terms go: ambient·k_d stays"
+            }
+            Mistake::TransparentCastsNoShadow => {
+                "transparent objects cast opaque shadows (semi-transparent shadows are extra credit)"
+            }
+            Mistake::IndexNotInverted => {
+                "N·d > 0 means the ray leaves: index n into 1, with the normal flipped"
+            }
+            Mistake::TotalInternalReflectionTransmitted => {
+                "on total internal reflection nothing is transmitted, and no reflected ray is added beyond reflectiveColor's"
+            }
+            Mistake::WeightIgnored => {
+                "a ray whose weight (parent's × |colour|) is below -weight is not traced"
+            }
         }
     }
 
@@ -214,6 +290,14 @@ impl Mistake {
             | Mistake::AmbientNotTimesDiffuse
             | Mistake::AmbientTimesDiffuseTwice => only(true, false, false),
             Mistake::DepthNotClamped => only(false, false, true),
+            Mistake::ReflectionVector
+            | Mistake::SpecularBehind
+            | Mistake::ShadowAcne
+            | Mistake::AmbientDroppedInShadow
+            | Mistake::TransparentCastsNoShadow
+            | Mistake::IndexNotInverted
+            | Mistake::TotalInternalReflectionTransmitted
+            | Mistake::WeightIgnored => only(true, false, false),
             Mistake::BackgroundNotBlack => only(false, true, true),
         }
     }
@@ -233,6 +317,14 @@ impl Mistake {
             return false;
         }
         let transformed = compiled.objects.iter().any(|o| o.xf.is_some());
+        let sec = &settings.secondary;
+        let lit = !compiled.lights.is_empty() || !compiled.point_lights.is_empty();
+        let specular = lit && compiled.phong.iter().any(|p| p.specular != Vec3::ZERO);
+        let transparent = compiled.phong.iter().any(|p| p.transparent != Vec3::ZERO);
+        // Refraction bends only across a change of index; leaving takes a second level.
+        let refracting =
+            |p: &crate::scene::Phong| p.transparent != Vec3::ZERO && p.index_of_refraction != 1.0;
+        let leaves = sec.bounces >= 2 && compiled.phong.iter().any(refracting);
         match self {
             Mistake::AngleInterpolated => compiled.camera.perspective,
             Mistake::OrthographicTminZero => !compiled.camera.perspective,
@@ -254,6 +346,29 @@ impl Mistake {
             Mistake::MatrixCourseSide | Mistake::RotateAxisAsWritten => {
                 scene_with(scene, Variant::one(self)).is_some()
             }
+            Mistake::ReflectionVector => specular,
+            Mistake::SpecularBehind => specular && !sec.specular_fix,
+            Mistake::ShadowAcne => sec.shadows && lit,
+            Mistake::AmbientDroppedInShadow => sec.shadows && lit && compiled.ambient != Vec3::ZERO,
+            Mistake::TransparentCastsNoShadow => sec.shadows && lit && transparent,
+            Mistake::IndexNotInverted => leaves,
+            // Past the critical angle leaving (n > 1), or entering an index below 1.
+            Mistake::TotalInternalReflectionTransmitted => {
+                leaves
+                    || (sec.bounces >= 1
+                        && compiled
+                            .phong
+                            .iter()
+                            .any(|p| refracting(p) && p.index_of_refraction < 1.0))
+            }
+            Mistake::WeightIgnored => {
+                sec.weight > 0.0
+                    && sec.bounces >= 1
+                    && compiled
+                        .phong
+                        .iter()
+                        .any(|p| p.reflective != Vec3::ZERO || p.transparent != Vec3::ZERO)
+            }
             Mistake::PixelCorners
             | Mistake::RowsFlipped
             | Mistake::Rounding
@@ -273,7 +388,7 @@ impl Mistake {
 
 /// One or more mistakes made at once (a diagnosis tries one, then pairs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Variant(u32);
+pub struct Variant(pub(super) u32);
 
 impl Variant {
     pub fn one(m: Mistake) -> Variant {
@@ -301,280 +416,11 @@ impl Variant {
 /// The scene as a program with the variant's transform mistakes would build it, or `None`
 /// when those mistakes change none of its transforms.
 pub fn scene_with(scene: &Scene, variant: Variant) -> Option<Scene> {
-    let mut out = scene.clone();
-    let mut changed = false;
-    let ids: Vec<_> = out.graph.iter().map(|(id, _)| id).collect();
-    for id in ids {
-        let Some(node) = out.graph.get_mut(id) else {
-            continue;
-        };
-        let NodeKind::Transform(ops) = &mut node.kind else {
-            continue;
-        };
-        if variant.has(Mistake::RotateAxisAsWritten) {
-            for op in ops.iter_mut() {
-                if let TransformOp::Rotate { axis, degrees } = *op
-                    && (axis.length() - 1.0).abs() > 1e-6
-                {
-                    *op = TransformOp::Matrix(rotation_as_written(axis, degrees));
-                    changed = true;
-                }
-            }
-        }
-        if variant.has(Mistake::MatrixCourseSide)
-            && ops.len() > 1
-            && let Some(m) = course_side_composition(ops)
-        {
-            *ops = vec![TransformOp::Matrix(m)];
-            changed = true;
-        }
-    }
-    changed.then_some(out)
-}
-
-/// The course's axis rotation with the axis used as written: Rodrigues' matrix for a unit
-/// axis, which for |axis| ≠ 1 is a rotation and a scale.
-fn rotation_as_written(a: Vec3, degrees: f32) -> Mat4 {
-    let (s, c) = degrees.to_radians().sin_cos();
-    let k = 1.0 - c;
-    let (x, y, z) = (a.x, a.y, a.z);
-    // Columns of the row-major course matrix.
-    Mat4::from_cols(
-        glam::Vec4::new(k * x * x + c, k * x * y + z * s, k * x * z - y * s, 0.0),
-        glam::Vec4::new(k * x * y - z * s, k * y * y + c, k * y * z + x * s, 0.0),
-        glam::Vec4::new(k * x * z + y * s, k * y * z - x * s, k * z * z + c, 0.0),
-        glam::Vec4::W,
+    course_parser_scene(
+        scene,
+        variant.has(Mistake::RotateAxisAsWritten),
+        variant.has(Mistake::MatrixCourseSide),
     )
-}
-
-/// The ops composed as the course parser does: M = M·T for each op in order, but
-/// M = T·M for `Matrix`; `None` where that is the same as tracelab's order.
-fn course_side_composition(ops: &[TransformOp]) -> Option<Mat4> {
-    let first_matrix = ops
-        .iter()
-        .position(|op| matches!(op, TransformOp::Matrix(_)))?;
-    // A Matrix first in the list composes the same on either side.
-    if first_matrix == 0
-        && ops
-            .iter()
-            .skip(1)
-            .all(|op| !matches!(op, TransformOp::Matrix(_)))
-    {
-        return None;
-    }
-    let mut m = Mat4::IDENTITY;
-    for op in ops {
-        m = match op {
-            TransformOp::Matrix(t) => *t * m,
-            other => m * other.matrix(),
-        };
-    }
-    Some(m)
-}
-
-/// Renders the variant `settings.variant` (which must be set) into a frame: one ray per
-/// pixel, rows in parallel. Transform mistakes need `scene` compiled from [`scene_with`].
-pub fn render_variant(scene: &CompiledScene, settings: &RenderSettings) -> Frame {
-    let v = settings.variant.unwrap_or(Variant(0));
-    let (w, h) = (settings.width, settings.height);
-    let mut frame = Frame::new(w, h);
-    if w == 0 || h == 0 {
-        return frame;
-    }
-    frame
-        .samples
-        .par_chunks_mut(w as usize)
-        .enumerate()
-        .for_each(|(row, samples)| {
-            for (x, dst) in samples.iter_mut().enumerate() {
-                *dst = trace(scene, settings, v, x as u32, row as u32);
-            }
-        });
-    if v.has(Mistake::RowsFlipped) {
-        let rows: Vec<Sample> = frame
-            .samples
-            .chunks(w as usize)
-            .rev()
-            .flatten()
-            .copied()
-            .collect();
-        frame.samples = rows;
-    }
-    frame
-}
-
-/// The screen point pixel (i, row) samples: its centre, or its lower-left corner.
-fn screen_point(i: u32, row: u32, w: u32, h: u32, corners: bool) -> (f32, f32) {
-    let s = w.max(h) as f32;
-    let j = h - 1 - row.min(h - 1);
-    let at = if corners { 0.0 } else { 0.5 };
-    let x = (i as f32 + at + (s - w as f32) * 0.5) / s;
-    let y = (j as f32 + at + (s - h as f32) * 0.5) / s;
-    (x, y)
-}
-
-fn camera_ray(scene: &CompiledScene, v: Variant, x: f32, y: f32) -> Ray {
-    let c = &scene.camera;
-    if c.perspective && v.has(Mistake::AngleInterpolated) {
-        let angle = 2.0 * (c.extent * 0.5).atan();
-        let d = c.direction
-            + ((x - 0.5) * angle).tan() * c.horizontal
-            + ((y - 0.5) * angle).tan() * c.up;
-        return Ray::new(c.center, d.normalize());
-    }
-    c.ray_at(x, y)
-}
-
-fn trace(scene: &CompiledScene, s: &RenderSettings, v: Variant, x: u32, row: u32) -> Sample {
-    let (sx, sy) = screen_point(x, row, s.width, s.height, v.has(Mistake::PixelCorners));
-    let ray = camera_ray(scene, v, sx, sy);
-    let t_min = if !scene.camera.perspective && v.has(Mistake::OrthographicTminZero) {
-        0.0
-    } else {
-        scene.camera.t_min()
-    };
-    let rule = if v.has(Mistake::DepthNotRescaled) {
-        ObjectRays::NormalizedNoRescale
-    } else {
-        s.object_rays
-    };
-    let rounding = v.has(Mistake::Rounding);
-    let Some(hit) = scene.intersect_with(&ray, t_min, f32::INFINITY, rule) else {
-        return Sample {
-            color: bytes(scene.background, rounding),
-            normal: [0; 3],
-            t: f32::INFINITY,
-            node: u32::MAX,
-        };
-    };
-    let at_hit = scene.ray_for_hit_point(&ray, &hit, rule);
-    let normal = world_normal(scene, s, v, &at_hit, &hit);
-    let color = shade(scene, s, v, &ray, &hit, normal);
-    Sample {
-        color: bytes(color, rounding),
-        normal: bytes(normal.abs(), rounding),
-        t: hit.t,
-        node: scene.hit_node(&hit).map_or(u32::MAX, |n| n.0),
-    }
-}
-
-fn world_normal(
-    scene: &CompiledScene,
-    s: &RenderSettings,
-    v: Variant,
-    at_hit: &Ray,
-    hit: &Hit,
-) -> Vec3 {
-    let rule = if v.has(Mistake::NormalByM) {
-        NormalTransform::Incorrect
-    } else {
-        s.normal_transform
-    };
-    let o = scene.objects.get(hit.object as usize);
-    if v.has(Mistake::NormalNotNormalized)
-        && let Some(o) = o
-        && let Some(xf) = &o.xf
-        && !matches!(o.shape, Shape::Csg(_))
-    {
-        let n = scene.object_normal(at_hit, hit).normalize_or(Vec3::Z);
-        return match rule {
-            NormalTransform::Correct => xf.normal_from_object * n,
-            NormalTransform::Incorrect => xf.world_from_object.transform_vector3(n),
-        };
-    }
-    scene.world_normal(at_hit, hit, rule)
-}
-
-/// The lecture's diffuse shading with the variant's shading mistakes.
-fn shade(
-    scene: &CompiledScene,
-    s: &RenderSettings,
-    v: Variant,
-    ray: &Ray,
-    hit: &Hit,
-    normal: Vec3,
-) -> Vec3 {
-    let kd = scene.hit_color(hit);
-    let mut n = normal;
-    let back = ray.direction.dot(normal) > 0.0;
-    let absolute = back && s.shade_back && v.has(Mistake::ShadeBackAbsolute);
-    if back && !absolute {
-        if s.shade_back || v.has(Mistake::BackFacesFlippedWithoutShadeBack) {
-            n = -normal;
-        } else if !v.has(Mistake::BackFacesLit) {
-            return Vec3::ZERO;
-        }
-    }
-    let mut c = if v.has(Mistake::AmbientNotTimesDiffuse) {
-        scene.ambient
-    } else if v.has(Mistake::AmbientTimesDiffuseTwice) {
-        scene.ambient * kd * kd
-    } else {
-        scene.ambient * kd
-    };
-    for &(l, color) in &scene.lights {
-        let d = l.dot(n);
-        let d = if absolute { d.abs() } else { d.max(0.0) };
-        c += d * color * kd;
-    }
-    c
-}
-
-fn byte(c: f32, rounding: bool) -> u8 {
-    if rounding {
-        // NaN as u8 is 0, as in `quantize`.
-        (c * 255.0).round().clamp(0.0, 255.0) as u8
-    } else {
-        quantize(c)
-    }
-}
-
-fn bytes(c: Vec3, rounding: bool) -> [u8; 3] {
-    [
-        byte(c.x, rounding),
-        byte(c.y, rounding),
-        byte(c.z, rounding),
-    ]
-}
-
-/// RGB8 bytes of one view of a variant's frame (rows top to bottom), with the variant's
-/// depth and background mistakes; for no variant, `Frame::rgb8`'s bytes.
-pub fn variant_rgb8(
-    scene: &CompiledScene,
-    frame: &Frame,
-    variant: Option<Variant>,
-    view: View,
-    depth: (f32, f32),
-) -> Vec<u8> {
-    let Some(v) = variant else {
-        return frame.rgb8(view, depth);
-    };
-    let background = bytes(scene.background, v.has(Mistake::Rounding));
-    let mut out = Vec::with_capacity(frame.samples.len() * 3);
-    for s in &frame.samples {
-        let px = match view {
-            View::Color => s.color,
-            View::Normals if !s.is_hit() && v.has(Mistake::BackgroundNotBlack) => background,
-            View::Normals => s.normal,
-            View::Depth if !s.is_hit() => {
-                if v.has(Mistake::BackgroundNotBlack) {
-                    background
-                } else {
-                    [0; 3]
-                }
-            }
-            View::Depth => {
-                let g = if v.has(Mistake::DepthNotClamped) && s.t < depth.0 {
-                    0
-                } else {
-                    byte(depth_shade(s.t, depth.0, depth.1), v.has(Mistake::Rounding))
-                };
-                [g; 3]
-            }
-        };
-        out.extend_from_slice(&px);
-    }
-    out
 }
 
 #[cfg(test)]
@@ -601,34 +447,5 @@ mod tests {
             [Mistake::PixelCorners, Mistake::Rounding]
         );
         assert!(!v.has(Mistake::NormalByM));
-    }
-
-    #[test]
-    fn a_unit_axis_rotates_as_glam_does_and_a_long_one_also_scales() {
-        let a = rotation_as_written(Vec3::Z, 90.0);
-        assert!(a.abs_diff_eq(Mat4::from_rotation_z(90f32.to_radians()), 1e-6));
-        let b = rotation_as_written(Vec3::new(0.0, 0.0, 2.0), 0.0);
-        // cos 0 = 1, k = 0: the identity whatever the axis; at 180° z² k + c = 4·2 − 1 = 7.
-        assert!(b.abs_diff_eq(Mat4::IDENTITY, 1e-6));
-        let c = rotation_as_written(Vec3::new(0.0, 0.0, 2.0), 180.0);
-        assert!((c.z_axis.z - 7.0).abs() < 1e-5, "{c}");
-    }
-
-    #[test]
-    fn the_course_puts_matrix_on_the_other_side() {
-        let t = Mat4::from_translation(Vec3::Y);
-        let ops = [TransformOp::UniformScale(2.0), TransformOp::Matrix(t)];
-        let m = course_side_composition(&ops).expect("differs");
-        // Course: M = T·S, so the origin goes to (0, 1, 0), not (0, 2, 0).
-        assert!((m.transform_point3(Vec3::ZERO) - Vec3::Y).length() < 1e-6);
-        assert_eq!(course_side_composition(&[TransformOp::Matrix(t)]), None);
-    }
-
-    #[test]
-    fn rounding_differs_from_truncating_only_past_the_half() {
-        assert_eq!(byte(0.5 / 255.0, false), 0);
-        assert_eq!(byte(0.5 / 255.0, true), 1);
-        assert_eq!(byte(f32::NAN, true), 0);
-        assert_eq!(byte(2.0, true), 255);
     }
 }
