@@ -99,6 +99,7 @@ fn job(dir: &Path, args: &[String], variant: Option<Variant>) -> (CompiledScene,
             bounces: num("-bounces", 1).map_or(0, |b| b as u32),
             weight: num("-weight", 1).unwrap_or(0.0),
             specular_fix: has("-specular_fix"),
+            ..Secondary::default()
         },
         ..RenderSettings::new(w, h)
     };

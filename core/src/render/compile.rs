@@ -98,7 +98,7 @@ pub struct CompiledScene {
     pub(super) unbounded: Vec<u32>,
     /// The course's uniform grid, when `-grid` asks for it: then every ray goes through it
     /// instead of `bvh` (`grid_scene.rs`).
-    pub(super) grid: Option<Arc<super::grid_scene::GridScene>>,
+    pub(super) grid: Option<Arc<super::grid_data::GridScene>>,
     /// The one object of a scene that holds a single mesh and nothing else: rays go straight
     /// to it, since the mesh tests its own box first (in object space, needing no second
     /// reciprocal of the direction).

@@ -6,42 +6,13 @@
 //! finds the BVH's closest hit bit for bit. It also counts, for `-stats`.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{UVec3, Vec3};
 
 use super::compile::{CompiledScene, Hit, Shape, tie_bound};
+use super::grid_data::{GridScene, RayCounts, WHOLE};
 use crate::accel::{CellVisit, MAX_CELLS, UniformGrid};
 use crate::geometry::{Aabb, Ray, moller_trumbore};
-
-/// A grid entry that stands for a whole object.
-const WHOLE: u32 = u32::MAX;
-
-/// The grid and what each of its entries is: (object, triangle of a mesh or `WHOLE`).
-#[derive(Debug)]
-pub struct GridScene {
-    pub grid: UniformGrid,
-    items: Vec<(u32, u32)>,
-    pub stats: RayCounts,
-}
-
-/// The course's `-stats` counters (`RayTracingStats`), counted while a grid is in use.
-#[derive(Debug, Default)]
-pub struct RayCounts {
-    pub cells_traversed: AtomicU64,
-    pub intersection_tests: AtomicU64,
-    pub shadow_rays: AtomicU64,
-    pub secondary_rays: AtomicU64,
-}
-
-impl RayCounts {
-    pub(super) fn add(c: &AtomicU64, n: u64) {
-        c.fetch_add(n, Ordering::Relaxed);
-    }
-    pub fn get(c: &AtomicU64) -> u64 {
-        c.load(Ordering::Relaxed)
-    }
-}
 
 /// Why a grid could not be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

@@ -19,7 +19,7 @@ use glam::Vec3;
 
 use super::RenderSettings;
 use super::compile::{CompiledScene, Hit};
-use super::grid_scene::RayCounts;
+use super::grid_data::RayCounts;
 use super::rules::{Ambient, Rules};
 use crate::geometry::Ray;
 use crate::scene::Phong;
