@@ -341,7 +341,7 @@ fn batch_judges_the_assignment_3_4_lines_and_names_the_lines_it_cannot_judge() {
     {
         println!("not rendered by tracelab: {l}");
     }
-    for flag in ["-grid", "-jittered_samples", "-stats"] {
+    for flag in ["-jittered_samples", "-random_samples"] {
         assert!(
             out.lines()
                 .any(|l| l.contains(flag) && l.contains("not implemented")),

@@ -17,7 +17,7 @@ use super::course::parse_course_args;
 use super::diagnose::{Judged, diagnose, diagnosis_text};
 use super::judge::{Criterion, compare, count, difference};
 use super::regions::regions;
-use super::render::{RenderJob, render_with_progress};
+use super::render::{RenderJob, compile_for, frame_for};
 use crate::exit::{Exit, check_size, usage};
 use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout_text};
 use crate::story::{one_line, pixel_report};
@@ -339,7 +339,7 @@ pub(super) fn judge_line<'s>(
     for m in &meshes {
         plan.reads(m);
     }
-    let compiled = CompiledScene::new(&scene);
+    let compiled = compile_for(job, &scene)?;
     let settings = RenderSettings {
         shade_back: job.shade_back,
         normal_transform: job.normal_transform,
@@ -347,7 +347,7 @@ pub(super) fn judge_line<'s>(
         secondary: job.secondary,
         ..RenderSettings::new(job.width, job.height)
     };
-    let frame = render_with_progress(&compiled, &settings)?;
+    let frame = frame_for(job, &compiled, &settings)?;
     let r = Reference {
         scene: &scene,
         compiled: &compiled,
@@ -360,7 +360,8 @@ pub(super) fn judge_line<'s>(
         .collect::<anyhow::Result<Vec<_>>>()?;
     let decoded: Vec<&Decoded> = verdicts.iter().filter_map(|v| v.decoded.as_ref()).collect();
     let mut diagnosis = String::new();
-    if !verdicts.iter().all(|v| v.ok) && !decoded.is_empty() {
+    // The catalogue's mistakes are of the render, not of a picture of the grid's cells.
+    if !verdicts.iter().all(|v| v.ok) && !decoded.is_empty() && !job.visualize_grid {
         // The mistake first: it says more than any pixel.
         let judged: Vec<Judged> = decoded
             .iter()

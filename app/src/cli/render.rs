@@ -217,14 +217,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         plan.check().map_err(OutputError::into_cli)?;
     }
     let start = std::time::Instant::now();
-    let mut compiled = CompiledScene::try_new(&scene).map_err(|e| {
-        anyhow::anyhow!("not enough memory to prepare the scene for rendering: {e}")
-    })?;
-    if let Some([x, y, z]) = job.grid {
-        compiled
-            .use_grid(glam::UVec3::new(x, y, z))
-            .map_err(|e| usage(e.to_string()))?;
-    }
+    let compiled = compile_for(job, &scene)?;
     let settings = RenderSettings {
         width: job.width,
         height: job.height,
@@ -234,11 +227,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         variant: None,
         secondary: job.secondary,
     };
-    let frame = if job.visualize_grid {
-        tracelab_core::render::visualize_grid(&compiled, job.width, job.height)
-    } else {
-        render_with_progress(&compiled, &settings)?
-    };
+    let frame = frame_for(job, &compiled, &settings)?;
     if job.stats {
         crate::io::write_stdout_text(&super::stats::stats_text(
             &compiled,
@@ -259,6 +248,38 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         save(View::Depth, (*min, *max), p)?;
     }
     Ok(())
+}
+
+/// The scene compiled for a job: with the course's uniform grid where `-grid` asks for one.
+pub(super) fn compile_for(
+    job: &RenderJob,
+    scene: &tracelab_core::Scene,
+) -> anyhow::Result<CompiledScene> {
+    let mut compiled = CompiledScene::try_new(scene).map_err(|e| {
+        anyhow::anyhow!("not enough memory to prepare the scene for rendering: {e}")
+    })?;
+    if let Some([x, y, z]) = job.grid {
+        compiled
+            .use_grid(glam::UVec3::new(x, y, z))
+            .map_err(|e| usage(e.to_string()))?;
+    }
+    Ok(compiled)
+}
+
+/// The job's image: the grid's occupied cells under `-visualize_grid`, else the render.
+pub(super) fn frame_for(
+    job: &RenderJob,
+    compiled: &CompiledScene,
+    settings: &RenderSettings,
+) -> anyhow::Result<tracelab_core::Frame> {
+    if job.visualize_grid {
+        return Ok(tracelab_core::render::visualize_grid(
+            compiled,
+            settings.width,
+            settings.height,
+        ));
+    }
+    render_with_progress(compiled, settings)
 }
 
 /// Bytes a `width` × `height` render takes at its peak: the frame, one view's RGB bytes
