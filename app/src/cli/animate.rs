@@ -40,6 +40,7 @@ pub struct AnimateArgs {
     /// A bounce sweep instead: a frame per bounce count from A to B (0 to 100, A ≤ B).
     #[arg(long, value_name = "A", allow_negative_numbers = true)]
     pub bounces_from: Option<u32>,
+    /// The bounce sweep's last count; the sweep's rays at B must stay under the render cap.
     #[arg(long, value_name = "B", allow_negative_numbers = true)]
     pub bounces_to: Option<u32>,
     /// Shadow rays toward every light (the course's -shadows).
