@@ -16,6 +16,10 @@ def cube():
     q = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
     return v, q
 
+def cube_triangles():
+    v, q = cube()
+    return v, [t for a, b, c, d in q for t in ((a, b, c), (a, c, d))]
+
 def icosphere(levels):
     t = (1 + 5 ** 0.5) / 2
     v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
@@ -57,6 +61,42 @@ def torus(R, r, nu, nv):
             f += [(a, d, c), (a, c, b)]
     return v, f
 
+def gem(n, table, crown, pavilion):
+    """A brilliant-like cut, girdle of radius 1 on y = 0: a flat table of n sides at height
+    `crown` (radius `table`), 3n crown facets (kites split in two and star triangles) and 2n
+    pavilion facets down to a culet at y = -`pavilion`. Convex, so each triangle is wound
+    outward by testing its normal against the centre."""
+    tau = 2 * math.pi
+    ring = lambda r, y, a0: [(r * math.cos(a0 + tau * i / n), y, r * math.sin(a0 + tau * i / n)) for i in range(n)]
+    T = ring(table, crown, 0.0)                          # table corners
+    U = ring((1 + table) / 2 * 1.04, crown * 0.45, tau / (2 * n))  # upper girdle / star points
+    G = ring(1.0, 0.0, 0.0) + ring(1.0, 0.0, tau / (2 * n))     # girdle, 2n points
+    G = [G[i // 2] if i % 2 == 0 else G[n + i // 2] for i in range(2 * n)]
+    v = T + U + G + [(0.0, crown, 0.0), (0.0, -pavilion, 0.0)]
+    t0, u0, g0, top, culet = 0, n, 2 * n, 4 * n, 4 * n + 1
+    f = []
+    for i in range(n):
+        j = (i + 1) % n
+        f.append((top, t0 + i, t0 + j))                       # table
+        f.append((t0 + i, u0 + i, t0 + j))                     # star facet
+        f.append((t0 + i, g0 + 2 * i, u0 + i))                 # kite, left half
+        f.append((u0 + i, g0 + 2 * i, g0 + 2 * i + 1))          # upper girdle facets
+        f.append((u0 + i, g0 + 2 * i + 1, g0 + (2 * i + 2) % (2 * n)))
+        f.append((t0 + j, u0 + i, g0 + (2 * i + 2) % (2 * n)))  # kite, right half
+    for k in range(2 * n):
+        f.append((g0 + k, g0 + (k + 1) % (2 * n), culet))      # pavilion
+    centre = (0.0, (crown - pavilion) / 4, 0.0)
+    out = []
+    for a, b, c in f:
+        e1 = [v[b][i] - v[a][i] for i in range(3)]
+        e2 = [v[c][i] - v[a][i] for i in range(3)]
+        nrm = (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+        mid = [(v[a][i] + v[b][i] + v[c][i]) / 3 - centre[i] for i in range(3)]
+        out.append((a, b, c) if sum(nrm[i] * mid[i] for i in range(3)) > 0 else (a, c, b))
+    return v, out
+
 write("assets/cube.obj", *cube(), "cube from -1 to 1, quads")
+write("assets/cube_triangles.obj", *cube_triangles(), "cube from -1 to 1, 12 triangles (for readers that take triangles only)")
 write("assets/icosphere.obj", *icosphere(3), "unit icosphere, 3 subdivisions (1280 triangles)")
 write("assets/torus.obj", *torus(1.0, 0.35, 48, 24), "torus, R = 1, r = 0.35, around the y axis (2304 triangles)")
+write("assets/gem.obj", *gem(8, 0.55, 0.42, 0.85), "brilliant-like gem: girdle radius 1 on y = 0, table of 8 sides, 48 crown and 16 pavilion facets (64 triangles)")

@@ -1,16 +1,20 @@
-//! Animations for slides: one value of one Transform op swept over N frames, each frame a
-//! full render (or the compare view: (M⁻¹)ᵀ left, M right), written as a PNG sequence and an
-//! animated PNG. Used by `tracelab animate` and the editor's File › Export animation.
+//! Animations for slides: one value of one Transform op swept over N frames, or the bounce
+//! count of assignment 4 stepped from A to B (a frame each), each frame a full render (or the
+//! compare view: (M⁻¹)ᵀ left, M right), written as a PNG sequence and an animated PNG. Used
+//! by `tracelab animate` and the editor's File › Export animation.
 //!
 //! Memory does not grow with the frames: one copy of the scene has the op rewritten frame by
-//! frame, each frame is rendered, written and dropped, and the animated PNG is streamed to
-//! its temporary file frame by frame (put in place only when complete).
+//! frame (a bounce sweep changes only the settings), each frame is rendered, written and
+//! dropped, and the animated PNG is streamed to its temporary file frame by frame (put in
+//! place only when complete).
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use tracelab_core::render::{MAX_IMAGE_SIDE, check_image_size, try_render_frame};
+use tracelab_core::render::{
+    MAX_BOUNCES, MAX_IMAGE_SIDE, Secondary, check_image_size, try_render_frame,
+};
 use tracelab_core::{
     CompiledScene, NodeId, NodeKind, NormalTransform, OutOfMemory, RenderSettings, Scene,
     TransformOp, View, check_scene,
@@ -43,6 +47,60 @@ impl Sweep {
         }
         let (from, to) = (f64::from(self.from), f64::from(self.to));
         (from + (to - from) * f64::from(k) / f64::from(self.frames - 1)) as f32
+    }
+}
+
+/// The bounce count stepped from `from` to `to` inclusive, one frame each; the scene and
+/// every other setting stay as they are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BounceSweep {
+    pub from: u32,
+    pub to: u32,
+}
+
+impl BounceSweep {
+    /// Both ends at most [`MAX_BOUNCES`], `from` ≤ `to`; the message names the ends as
+    /// `from_flag` and `to_flag`.
+    pub fn check(&self, from_flag: &str, to_flag: &str) -> Result<(), String> {
+        for (flag, v) in [(from_flag, self.from), (to_flag, self.to)] {
+            if v > MAX_BOUNCES {
+                return Err(format!("{flag} {v}: at most {MAX_BOUNCES} levels"));
+            }
+        }
+        if self.from > self.to {
+            return Err(format!(
+                "{from_flag} {} is after {to_flag} {}: expected {from_flag} ≤ {to_flag}",
+                self.from, self.to
+            ));
+        }
+        Ok(())
+    }
+
+    /// One frame per bounce count (0 where the ends are the wrong way round).
+    pub fn frames(&self) -> u32 {
+        (self.to + 1).saturating_sub(self.from)
+    }
+
+    pub fn bounces(&self, k: u32) -> u32 {
+        self.from.saturating_add(k)
+    }
+}
+
+/// What changes from one frame to the next: one of two kinds of sweep, written alike.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Animated {
+    /// One number of one Transform op.
+    Op(Sweep),
+    /// The bounce count (`RenderSettings::secondary.bounces`).
+    Bounces(BounceSweep),
+}
+
+impl Animated {
+    pub fn frames(&self) -> u32 {
+        match self {
+            Animated::Op(s) => s.frames,
+            Animated::Bounces(b) => b.frames(),
+        }
     }
 }
 
@@ -154,6 +212,67 @@ pub fn frame_scene(scene: &Scene, sweep: &Sweep, k: u32) -> Result<Scene, String
     FrameScenes::new(scene, sweep)?.frame(k).cloned()
 }
 
+/// Each frame's scene and settings, for either kind of sweep.
+enum FrameSource<'a> {
+    // Boxed: a whole scene beside a reference and two numbers.
+    Op(Box<FrameScenes>),
+    Bounces(&'a Scene, BounceSweep),
+}
+
+impl<'a> FrameSource<'a> {
+    /// Checks the whole sweep before any frame is rendered: every op value against the
+    /// scene's rules, or every bounce count in bounds and the last one's rays under the cap.
+    fn new(
+        scene: &'a Scene,
+        animated: &Animated,
+        settings: &RenderSettings,
+    ) -> Result<Self, AnimateError> {
+        match animated {
+            Animated::Op(sweep) => {
+                let mut scenes = FrameScenes::new(scene, sweep).map_err(AnimateError::Refused)?;
+                for k in 0..sweep.frames {
+                    scenes.frame(k).map_err(AnimateError::Refused)?;
+                }
+                Ok(FrameSource::Op(Box::new(scenes)))
+            }
+            Animated::Bounces(b) => {
+                b.check("the first bounce count", "the last")
+                    .map_err(AnimateError::Refused)?;
+                let compiled = CompiledScene::try_new(scene).map_err(|e| {
+                    AnimateError::OutOfMemory(format!(
+                        "not enough memory to prepare the scene (needs about {} MB more)",
+                        tracelab_core::memory::megabytes(e.bytes)
+                    ))
+                })?;
+                // The rays grow with the bounce count: the last frame is the worst.
+                Secondary {
+                    bounces: b.to,
+                    ..settings.secondary
+                }
+                .check_bounded_as(&compiled, "bounces")
+                .map_err(AnimateError::Refused)?;
+                Ok(FrameSource::Bounces(scene, *b))
+            }
+        }
+    }
+
+    /// Frame `k`'s scene and settings.
+    fn frame(
+        &mut self,
+        k: u32,
+        settings: &RenderSettings,
+    ) -> Result<(&Scene, RenderSettings), String> {
+        match self {
+            FrameSource::Op(scenes) => Ok((scenes.frame(k)?, *settings)),
+            FrameSource::Bounces(scene, b) => {
+                let mut s = *settings;
+                s.secondary.bounces = b.bounces(k);
+                Ok((*scene, s))
+            }
+        }
+    }
+}
+
 /// One frame's picture as RGB bytes: the colour image, or the compare view side by side
 /// (twice as wide). Every big buffer is allocated fallibly.
 pub fn frame_image(
@@ -185,41 +304,56 @@ pub fn frame_image(
     Ok(out)
 }
 
-/// The editor's export form: a sweep, the compare switch and the folder.
+/// The editor's export form: a sweep of either kind, the compare switch and the folder.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AnimationForm {
-    pub node: NodeId,
+    /// The Transform whose op is swept; `None` where none was selected: a bounce sweep only.
+    pub node: Option<NodeId>,
+    /// Sweep the bounce count instead of an op.
+    pub bounce_sweep: bool,
     pub op: usize,
     pub component: usize,
     pub from: f32,
     pub to: f32,
     pub frames: u32,
+    pub bounces: BounceSweep,
     pub compare: bool,
     pub folder: String,
 }
 
 impl AnimationForm {
-    pub fn new(node: NodeId) -> Self {
+    /// An op sweep of `node`'s Transform, or with no Transform a bounce sweep from 0 to
+    /// `bounces` (the view's count, at least 1).
+    pub fn new(node: Option<NodeId>, bounces: u32) -> Self {
         AnimationForm {
             node,
+            bounce_sweep: node.is_none(),
             op: 0,
             component: 0,
             from: 0.0,
             to: 1.0,
             frames: 24,
+            bounces: BounceSweep {
+                from: 0,
+                to: bounces.clamp(1, MAX_BOUNCES),
+            },
             compare: false,
             folder: "animation".into(),
         }
     }
 
-    pub fn sweep(&self) -> Sweep {
-        Sweep {
-            node: self.node,
-            op: self.op,
-            component: self.component,
-            from: self.from,
-            to: self.to,
-            frames: self.frames,
+    /// What the form sweeps: the bounce count, or the op where a Transform is named.
+    pub fn animated(&self) -> Animated {
+        match self.node {
+            Some(node) if !self.bounce_sweep => Animated::Op(Sweep {
+                node,
+                op: self.op,
+                component: self.component,
+                from: self.from,
+                to: self.to,
+                frames: self.frames,
+            }),
+            _ => Animated::Bounces(self.bounces),
         }
     }
 }
@@ -289,30 +423,29 @@ pub fn frame_size(settings: &RenderSettings, compare: bool) -> Result<(u32, u32)
 }
 
 /// Renders and writes every frame in order, each dropped once written, and the animated PNG
-/// streamed beside them; `progress(done)` after each frame. Every frame's scene is checked
-/// before anything is rendered or written, so a sweep through a refused value fails at once.
+/// streamed beside them; `progress(done)` after each frame. Every frame's scene (or bounce
+/// count) is checked before anything is rendered or written, so a sweep through a refused
+/// value fails at once.
 /// Returns the files written, the animated PNG last.
 pub fn export(
     scene: &Scene,
-    sweep: &Sweep,
+    animated: &Animated,
     settings: &RenderSettings,
     compare: bool,
     to: &Destination,
     cancel: &AtomicBool,
     mut progress: impl FnMut(u32),
 ) -> Result<Vec<PathBuf>, AnimateError> {
-    if sweep.frames == 0 {
+    let frames = animated.frames();
+    if frames == 0 {
         return Err(AnimateError::Refused(
             "an animation needs at least one frame".into(),
         ));
     }
     check_stem(&to.stem).map_err(AnimateError::Output)?;
     let (w, h) = frame_size(settings, compare).map_err(AnimateError::Output)?;
-    let mut scenes = FrameScenes::new(scene, sweep).map_err(AnimateError::Refused)?;
-    for k in 0..sweep.frames {
-        scenes.frame(k).map_err(AnimateError::Refused)?;
-    }
-    let files = frame_files(to, sweep.frames)?;
+    let mut source = FrameSource::new(scene, animated, settings)?;
+    let files = frame_files(to, frames)?;
     let write_err = |p: &Path, e: &dyn std::fmt::Display| {
         AnimateError::Output(format!("{}: cannot write: {e}", p.display()))
     };
@@ -320,14 +453,14 @@ pub fn export(
     let mut apng_file = BufWriter::new(
         AtomicFile::create_no_follow(&apng_path).map_err(|e| write_err(&apng_path, &e))?,
     );
-    let mut apng = apng_writer(&mut apng_file, (w, h), sweep.frames, to.delay_ms)
+    let mut apng = apng_writer(&mut apng_file, (w, h), frames, to.delay_ms)
         .map_err(|e| write_err(&apng_path, &e))?;
-    for (k, path) in (0..sweep.frames).zip(&files) {
+    for (k, path) in (0..frames).zip(&files) {
         if cancel.load(Ordering::Relaxed) {
             return Err(AnimateError::Cancelled { written: k });
         }
-        let scene = scenes.frame(k).map_err(AnimateError::Refused)?;
-        let rgb = frame_image(scene, settings, compare).map_err(|e| {
+        let (scene, settings) = source.frame(k, settings).map_err(AnimateError::Refused)?;
+        let rgb = frame_image(scene, &settings, compare).map_err(|e| {
             AnimateError::OutOfMemory(format!(
                 "not enough memory to render frame {k} at {w}x{h} (needs about {} MB more)",
                 tracelab_core::memory::megabytes(e.bytes)
@@ -387,17 +520,17 @@ fn apng_writer<W: Write>(
     enc.write_header()
 }
 
-/// One frame as a PNG file's bytes.
-fn encode_png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, png::EncodingError> {
+/// One frame as a PNG file's bytes, encoded as `render --output` encodes a PNG
+/// (`io::encode_image`), so that a frame is the single render's file byte for byte.
+fn encode_png(rgb: &[u8], w: u32, h: u32) -> image::ImageResult<Vec<u8>> {
+    use image::ImageEncoder;
     let mut bytes = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut bytes, w, h);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header()?;
-        writer.write_image_data(rgb)?;
-        writer.finish()?;
-    }
+    image::codecs::png::PngEncoder::new(&mut bytes).write_image(
+        rgb,
+        w,
+        h,
+        image::ExtendedColorType::Rgb8,
+    )?;
     Ok(bytes)
 }
 
@@ -434,6 +567,30 @@ mod tests {
         };
         let v: Vec<f32> = (0..5).map(|k| s.value(k)).collect();
         assert_eq!(v, [-3e38, -1.5e38, 0.0, 1.5e38, 3e38]);
+    }
+
+    #[test]
+    fn a_bounce_sweep_has_a_frame_per_count_and_its_ends_are_checked() {
+        let b = BounceSweep { from: 2, to: 5 };
+        assert_eq!(b.frames(), 4);
+        assert_eq!(
+            (0..4).map(|k| b.bounces(k)).collect::<Vec<_>>(),
+            [2, 3, 4, 5]
+        );
+        assert!(b.check("--a", "--b").is_ok());
+        let late = BounceSweep { from: 3, to: 1 };
+        assert_eq!(late.frames(), 0);
+        assert!(late.check("--a", "--b").is_err_and(|m| m.contains("--a 3")));
+        let deep = BounceSweep { from: 0, to: 101 };
+        assert!(
+            deep.check("--a", "--b")
+                .is_err_and(|m| m.starts_with("--b 101"))
+        );
+        assert!(
+            BounceSweep { from: 100, to: 100 }
+                .check("--a", "--b")
+                .is_ok()
+        );
     }
 
     #[test]

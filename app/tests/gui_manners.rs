@@ -407,17 +407,29 @@ fn double_clicking_a_folder_in_the_open_dialog_enters_it_and_opens_nothing() {
 }
 
 /// Bug 6: a Lecture figure asked for over unsaved changes, then Cancel: nothing of it is
-/// applied (caption, split compare). Discard (the positive control) applies it all.
+/// applied (caption, split compare; a bounce figure's rays and shade-back). Discard (the
+/// positive control) applies it all.
 #[test]
 fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
     use tracelab::gui::command::AppCommand;
     use tracelab::gui::lecture::FIGURES;
     use tracelab::gui::panels::viewport::Compare;
-    let i = FIGURES
+    let split = FIGURES
         .iter()
         .position(|f| f.compare == Compare::Split)
         .expect("a split figure");
-    for (answer, applied) in [("Cancel", false), ("Discard changes", true)] {
+    // A bounce figure brings View › Rays and shade-back: cancelled, neither is applied.
+    let bounces = FIGURES
+        .iter()
+        .position(|f| f.secondary.bounces > 0)
+        .expect("a bounce figure");
+    let cases = [
+        (split, "Cancel", false),
+        (split, "Discard changes", true),
+        (bounces, "Cancel", false),
+        (bounces, "Discard changes", true),
+    ];
+    for (i, answer, applied) in cases {
         let mut h = prepared("lecture");
         let view = format!("{:?}", h.state().view);
         let scene = h.state().doc.scene.clone();
@@ -436,7 +448,11 @@ fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
         settle(&mut h);
         let app = h.state();
         assert_eq!(app.lecture.is_some(), applied, "{answer}");
-        assert_eq!(app.view.compare == Compare::Split, applied, "{answer}");
+        let f = &FIGURES[i];
+        let shown = app.view.compare == f.compare
+            && app.view.secondary == f.secondary
+            && app.view.shade_back == f.shade_back;
+        assert_eq!(shown, applied, "{} {answer}", f.file);
         if !applied {
             assert_eq!(format!("{:?}", app.view), view);
             assert_eq!(app.doc.scene, scene);

@@ -176,17 +176,121 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     ] {
         assert!(PathBuf::from(&dir).join(f).is_file(), "{f}");
     }
-    // Without a Transform selected the dialog is refused with a reason.
+    // Without a Transform selected the dialog offers the bounce sweep only.
     h.state_mut().doc.select(None);
     h.state_mut().animation = None;
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
-    assert!(h.state().animation.is_none());
-    assert!(
-        h.state()
-            .doc
-            .messages
-            .iter()
-            .any(|m| m.text.contains("select a Transform first"))
+    let form = h.state().animation.clone().expect("the dialog");
+    assert_eq!(form.node, None);
+    assert!(form.bounce_sweep);
+}
+
+/// File › Export animation's bounce sweep: opened on a bounce figure, it writes a frame per
+/// bounce count with the view's rays, each the render the view shows at that count.
+#[test]
+fn a_bounce_sweep_exported_from_the_editor_writes_a_frame_per_count() {
+    use tracelab::gui::lecture::FIGURES;
+    use tracelab_core::RenderSettings;
+    let mut h = harness((24, 24));
+    settle(&mut h);
+    let i = FIGURES
+        .iter()
+        .position(|f| f.file == "bounces_mirrors.txt")
+        .expect("in the menu");
+    h.state_mut().queue(AppCommand::OpenLecture(i));
+    settle(&mut h);
+    h.state_mut().doc.select(None);
+    h.state_mut().queue(AppCommand::AnimationDialog);
+    h.step();
+    let mut form = h.state().animation.clone().expect("the dialog");
+    assert!(form.bounce_sweep);
+    assert_eq!(
+        (form.bounces.from, form.bounces.to),
+        (0, 3),
+        "the view's count"
     );
+    let _ = h.get_by_label_contains("bounces from");
+    let dir = std::env::temp_dir().join(format!("tracelab-lecture-bounces-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    form.bounces.to = 2;
+    form.folder = dir.to_string_lossy().into_owned();
+    h.state_mut().queue(AppCommand::StartAnimation(form));
+    let start = Instant::now();
+    loop {
+        h.step();
+        if h.state().animation_running.is_none()
+            && h.state()
+                .doc
+                .messages
+                .iter()
+                .any(|m| m.text.contains("exported"))
+        {
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "export did not finish"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let scene = h.state().doc.scene.clone();
+    let view = h.state().view.secondary;
+    for k in 0..3u32 {
+        let frame = image::open(dir.join(format!("frame_{k:04}.png")))
+            .expect("frame")
+            .to_rgb8();
+        let mut settings = RenderSettings {
+            shade_back: true,
+            secondary: view,
+            ..RenderSettings::new(24, 24)
+        };
+        settings.secondary.bounces = k;
+        let single = tracelab_core::render_frame(&tracelab_core::compile(&scene), &settings)
+            .rgb8(tracelab_core::View::Color, (0.0, 1.0));
+        assert_eq!(frame.as_raw(), &single, "frame {k}");
+    }
+    assert!(dir.join("frame.apng.png").is_file());
+    assert!(!dir.join("frame_0003.png").exists());
+}
+
+/// The bounce figures (issue 30): each opens with its scene's rays (shadows, its last bounce
+/// count, weight 0.01) and shade-back, the render on screen uses them, and a plain figure
+/// opened after it puts the course's defaults back.
+#[test]
+fn a_bounce_figure_opens_with_its_rays_and_a_plain_figure_puts_them_back() {
+    use tracelab::gui::lecture::FIGURES;
+    use tracelab_core::render::Secondary;
+    let mut h = harness((24, 24));
+    settle(&mut h);
+    for file in [
+        "bounces_mirrors.txt",
+        "bounces_glass_bars.txt",
+        "bounces_gem.txt",
+    ] {
+        let i = FIGURES
+            .iter()
+            .position(|f| f.file == file)
+            .expect("in the menu");
+        h.state_mut().queue(AppCommand::OpenLecture(i));
+        settle(&mut h);
+        let view = &h.state().view;
+        assert_eq!(h.state().lecture, Some(i), "{file}");
+        assert!(view.shade_back, "{file}");
+        assert!(view.secondary.shadows, "{file}");
+        assert_eq!(view.secondary.weight, 0.01, "{file}");
+        let last = if file == "bounces_mirrors.txt" { 3 } else { 5 };
+        assert_eq!(view.secondary.bounces, last, "{file}");
+        let _ = h.get_by_label_contains(&format!("View › Rays: step the bounces from 0 to {last}"));
+        let job = h
+            .state()
+            .worker
+            .with_published(|p| p.map(|p| (p.job.settings.secondary, p.job.settings.shade_back)));
+        assert_eq!(job, Some((h.state().view.secondary, true)), "{file}");
+    }
+    h.state_mut()
+        .queue(AppCommand::OpenLecture(depth_t_index()));
+    settle(&mut h);
+    assert_eq!(h.state().view.secondary, Secondary::NONE);
+    assert!(!h.state().view.shade_back);
 }

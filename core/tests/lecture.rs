@@ -8,6 +8,7 @@ mod common;
 use common::repo;
 use std::path::{Path, PathBuf};
 
+use tracelab_core::render::Secondary;
 use tracelab_core::{
     Frame, MeshCache, NormalTransform, ObjectRays, RenderSettings, Scene, View, compile,
     load_scene, render_frame,
@@ -22,6 +23,9 @@ struct Figure {
     view: View,
     normal_transform: NormalTransform,
     object_rays: ObjectRays,
+    /// The rays of assignment 4 (shadows, bounces, weight) and shade-back, for the bounce
+    /// figures; `None` is the lecture's plain render.
+    rays: Option<Secondary>,
 }
 
 const fn fig(
@@ -36,6 +40,7 @@ const fn fig(
         view,
         normal_transform,
         object_rays: ObjectRays::Unnormalized,
+        rays: None,
     }
 }
 
@@ -47,6 +52,37 @@ const fn fig_rays(golden: &'static str, scene: &'static str, object_rays: Object
         view: Color,
         normal_transform: Correct,
         object_rays,
+        rays: None,
+    }
+}
+
+/// A bounce figure at its last bounce count: `-shadows -shade_back -bounces N -weight 0.01`,
+/// as its comment header says.
+const fn fig_bounces(scene: &'static str, bounces: u32) -> Figure {
+    Figure {
+        golden: scene,
+        scene,
+        view: Color,
+        normal_transform: Correct,
+        object_rays: ObjectRays::Unnormalized,
+        rays: Some(rays(bounces)),
+    }
+}
+
+/// The bounce figures and the bounce count each steps up to (`BOUNCE_FIGURES` in
+/// app/src/gui/lecture.rs says the same).
+const BOUNCE_FIGURES: &[(&str, u32)] = &[
+    ("bounces_mirrors", 3),
+    ("bounces_glass_bars", 5),
+    ("bounces_gem", 5),
+];
+
+const fn rays(bounces: u32) -> Secondary {
+    Secondary {
+        shadows: true,
+        bounces,
+        weight: 0.01,
+        ..Secondary::NONE
     }
 }
 
@@ -96,6 +132,9 @@ const FIGURES: &[Figure] = &[
         "depth_t",
         ObjectRays::NormalizedNoRescale,
     ),
+    fig_bounces("bounces_mirrors", 3),
+    fig_bounces("bounces_glass_bars", 5),
+    fig_bounces("bounces_gem", 5),
 ];
 
 fn scene_path(name: &str) -> PathBuf {
@@ -128,6 +167,16 @@ fn render_with(scene: &Scene, normal_transform: NormalTransform, object_rays: Ob
     render_frame(&compile(scene), &settings)
 }
 
+/// A render with the rays of assignment 4 and shade-back, as the bounce figures' lines ask.
+fn render_rays(scene: &Scene, size: u32, secondary: Secondary) -> Frame {
+    let settings = RenderSettings {
+        shade_back: true,
+        secondary,
+        ..RenderSettings::new(size, size)
+    };
+    render_frame(&compile(scene), &settings)
+}
+
 #[test]
 fn every_lecture_scene_has_a_figure() {
     let mut files: Vec<String> = std::fs::read_dir(repo().join("scenes/lecture"))
@@ -151,7 +200,10 @@ fn lecture_scenes_match_their_reviewed_golden_images() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/lecture");
     let mut failures = Vec::new();
     for f in FIGURES {
-        let frame = render_with(&load(f.scene), f.normal_transform, f.object_rays);
+        let frame = match f.rays {
+            Some(rays) => render_rays(&load(f.scene), SIZE, rays),
+            None => render_with(&load(f.scene), f.normal_transform, f.object_rays),
+        };
         assert!(
             frame.samples.iter().any(|s| s.is_hit()),
             "{}: nothing visible",
@@ -263,4 +315,38 @@ fn shading_figures_follow_the_lecture_formula() {
         h.color,
         [kd.x, kd.y, kd.z].map(tracelab_core::render::quantize)
     );
+}
+
+#[test]
+fn every_bounce_of_a_bounce_figure_changes_the_image() {
+    for &(name, last) in BOUNCE_FIGURES {
+        let scene = load(name);
+        let images: Vec<Vec<u8>> = (0..=last)
+            .map(|n| render_rays(&scene, 48, rays(n)).rgb8(Color, (0.0, 1.0)))
+            .collect();
+        for n in 1..=last as usize {
+            let changed = images[n]
+                .chunks_exact(3)
+                .zip(images[n - 1].chunks_exact(3))
+                .filter(|(a, b)| a != b)
+                .count();
+            assert!(
+                changed > 0,
+                "{name}: -bounces {n} gives the image of -bounces {}",
+                n - 1
+            );
+        }
+    }
+}
+
+#[test]
+fn the_bounce_figures_say_their_command_line() {
+    for &(name, last) in BOUNCE_FIGURES {
+        let text = std::fs::read_to_string(scene_path(name)).expect("scene");
+        let line = format!(
+            "tracelab -input scenes/lecture/{name}.txt -size 300 300 -output a.png -shadows \
+             -shade_back -bounces {last} -weight 0.01"
+        );
+        assert!(text.contains(&line), "{name}: the header lacks {line:?}");
+    }
 }

@@ -62,7 +62,7 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to image files (format from the extension: .png .tga .ppm .bmp).
     Render(RenderArgs),
-    /// Sweep one number of a Transform op over N frames: a PNG sequence and an animated PNG.
+    /// Sweep one number of a Transform op over N frames, or the bounce count from A to B: a PNG sequence and an animated PNG.
     Animate(animate::AnimateArgs),
     /// Compare your image with the reference for a course command line (after --): verdict, the mistake it matches, regions, heat map.
     #[command(long_about = diff::LONG_ABOUT)]

@@ -1,12 +1,14 @@
 //! File › Export animation: the form (which op of the selected Transform, which number,
-//! from, to, frames, compare, folder) and the export running on its own thread with a
-//! progress bar and Cancel. The form only asks: starting and cancelling are `AppCommand`s.
+//! from, to, frames; or the bounce count from A to B with the view's rays; compare, folder)
+//! and the export running on its own thread with a progress bar and Cancel. The form only
+//! asks: starting and cancelling are `AppCommand`s.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
+use tracelab_core::render::MAX_BOUNCES;
 use tracelab_core::{NodeKind, RenderSettings, Scene};
 
 pub use crate::animation::AnimationForm;
@@ -32,7 +34,9 @@ impl Running {
         let (tx, rx) = channel();
         let done = Arc::new(AtomicU32::new(0));
         let cancel = Arc::new(AtomicBool::new(false));
-        let (d, c, sweep, compare) = (done.clone(), cancel.clone(), form.sweep(), form.compare);
+        let (d, c, compare) = (done.clone(), cancel.clone(), form.compare);
+        let sweep = form.animated();
+        let total = sweep.frames();
         let to = Destination {
             dir: PathBuf::from(&form.folder),
             stem: "frame".into(),
@@ -65,7 +69,7 @@ impl Running {
         });
         Running {
             done,
-            total: form.frames,
+            total,
             cancel,
             result: rx,
         }
@@ -85,40 +89,35 @@ pub fn ui(
     running: Option<&Running>,
 ) -> Option<AppCommand> {
     let mut asked = None;
-    let ops = match scene.graph.get(form.node).map(|n| &n.kind) {
+    let ops = match form
+        .node
+        .and_then(|id| scene.graph.get(id))
+        .map(|n| &n.kind)
+    {
         Some(NodeKind::Transform(ops)) => ops.clone(),
         _ => Vec::new(),
     };
     egui::Window::new("Export animation").collapsible(false).resizable(false).show(ctx, |ui| {
         if ops.is_empty() {
-            ui.label("Select a Transform with at least one op.");
-            if ui.button("Close").clicked() {
-                asked = Some(AppCommand::CloseAnimationDialog);
-            }
-            return;
+            // Nothing to sweep but the bounce count.
+            form.bounce_sweep = true;
+        } else {
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut form.bounce_sweep, false, "an op of the Transform");
+                ui.radio_value(&mut form.bounce_sweep, true, "the bounce count");
+            });
         }
-        form.op = form.op.min(ops.len() - 1);
-        egui::ComboBox::from_label("op")
-            .selected_text(format!("{}: {}", form.op, ops[form.op].summary()))
-            .show_ui(ui, |ui| {
-                for (i, op) in ops.iter().enumerate() {
-                    ui.selectable_value(&mut form.op, i, format!("{i}: {}", op.summary()));
-                }
+        if form.bounce_sweep {
+            let b = &mut form.bounces;
+            ui.horizontal(|ui| {
+                ui.add(egui::DragValue::new(&mut b.from).range(0..=MAX_BOUNCES).prefix("bounces from "));
+                ui.add(egui::DragValue::new(&mut b.to).range(0..=MAX_BOUNCES).prefix("to "));
             });
-        let names = components(&ops[form.op]);
-        form.component = form.component.min(names.len().saturating_sub(1));
-        egui::ComboBox::from_label("number")
-            .selected_text(names.get(form.component).cloned().unwrap_or_default())
-            .show_ui(ui, |ui| {
-                for (i, n) in names.iter().enumerate() {
-                    ui.selectable_value(&mut form.component, i, n);
-                }
-            });
-        ui.horizontal(|ui| {
-            ui.add(egui::DragValue::new(&mut form.from).speed(0.05).prefix("from "));
-            ui.add(egui::DragValue::new(&mut form.to).speed(0.05).prefix("to "));
-            ui.add(egui::DragValue::new(&mut form.frames).range(1..=1000).prefix("frames "));
-        });
+            b.to = b.to.max(b.from);
+            ui.small("A frame per bounce count, with View › Rays' shadows and weight.");
+        } else {
+            op_fields(ui, form, &ops);
+        }
         ui.checkbox(&mut form.compare, "compare view: (M^-1)^T left, M right");
         ui.horizontal(|ui| {
             ui.label("folder");
@@ -146,4 +145,41 @@ pub fn ui(
         }
     });
     asked
+}
+
+/// The op sweep's fields: which op and number, from, to, frames.
+fn op_fields(ui: &mut egui::Ui, form: &mut AnimationForm, ops: &[tracelab_core::TransformOp]) {
+    form.op = form.op.min(ops.len().saturating_sub(1));
+    let Some(op) = ops.get(form.op) else {
+        return;
+    };
+    egui::ComboBox::from_label("op")
+        .selected_text(format!("{}: {}", form.op, op.summary()))
+        .show_ui(ui, |ui| {
+            for (i, op) in ops.iter().enumerate() {
+                ui.selectable_value(&mut form.op, i, format!("{i}: {}", op.summary()));
+            }
+        });
+    let names = components(op);
+    form.component = form.component.min(names.len().saturating_sub(1));
+    egui::ComboBox::from_label("number")
+        .selected_text(names.get(form.component).cloned().unwrap_or_default())
+        .show_ui(ui, |ui| {
+            for (i, n) in names.iter().enumerate() {
+                ui.selectable_value(&mut form.component, i, n);
+            }
+        });
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::DragValue::new(&mut form.from)
+                .speed(0.05)
+                .prefix("from "),
+        );
+        ui.add(egui::DragValue::new(&mut form.to).speed(0.05).prefix("to "));
+        ui.add(
+            egui::DragValue::new(&mut form.frames)
+                .range(1..=1000)
+                .prefix("frames "),
+        );
+    });
 }

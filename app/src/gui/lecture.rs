@@ -1,8 +1,10 @@
 //! The Lecture menu: the figures of `scenes/lecture/`, each with its caption, the view it
-//! needs (tab, normal rule, depth-t rule, compare) and two lines on what to look at.
+//! needs (tab, normal rule, depth-t rule, compare, the rays of assignments 3–4 and
+//! shade-back) and two lines on what to look at.
 
 use std::path::PathBuf;
 
+use tracelab_core::render::Secondary;
 use tracelab_core::{NormalTransform, ObjectRays};
 
 use crate::gui::panels::viewport::{Compare, Tab, ViewSettings};
@@ -20,6 +22,11 @@ pub struct Figure {
     pub object_rays: ObjectRays,
     /// The depth view's range, where the figure uses it.
     pub depth: Option<(f32, f32)>,
+    /// View › Rays as the figure opens: the course's defaults (none) but for the bounce
+    /// figures, which open at their last bounce count.
+    pub secondary: Secondary,
+    /// The bounce figures see the inside of glass, so they shade back faces (`-shade_back`).
+    pub shade_back: bool,
 }
 
 const fn fig(file: &'static str, caption: &'static str, look: [&'static str; 2]) -> Figure {
@@ -32,6 +39,29 @@ const fn fig(file: &'static str, caption: &'static str, look: [&'static str; 2])
         normal_transform: NormalTransform::Correct,
         object_rays: ObjectRays::Unnormalized,
         depth: None,
+        secondary: Secondary::NONE,
+        shade_back: false,
+    }
+}
+
+/// A bounce figure: opened with `-shadows -shade_back -bounces last -weight 0.01`, as its
+/// scene's header says; the caption's second line tells how to step the bounces.
+const fn bounces(
+    file: &'static str,
+    caption: &'static str,
+    first: &'static str,
+    last: u32,
+    step: &'static str,
+) -> Figure {
+    Figure {
+        secondary: Secondary {
+            shadows: true,
+            bounces: last,
+            weight: 0.01,
+            ..Secondary::NONE
+        },
+        shade_back: true,
+        ..fig(file, caption, [first, step])
     }
 }
 
@@ -178,6 +208,27 @@ pub static FIGURES: &[Figure] = &[
             ],
         )
     },
+    bounces(
+        "bounces_mirrors.txt",
+        "Bounces: mirrors",
+        "A chrome ball between mirror walls: each bounce adds a level of reflections.",
+        3,
+        "View › Rays: step the bounces from 0 to 3 to see each level.",
+    ),
+    bounces(
+        "bounces_glass_bars.txt",
+        "Bounces: glass bars",
+        "Three glass bars in a row: two bounces cross one bar (in, out), so each lets the eye through one more surface.",
+        5,
+        "View › Rays: step the bounces from 0 to 5 to see each level.",
+    ),
+    bounces(
+        "bounces_gem.txt",
+        "Bounces: a faceted gem",
+        "A gem of index 2.4 under red, green and blue lights: light reflects inside it (total internal reflection) before it leaves.",
+        5,
+        "View › Rays: step the bounces from 0 to 5 to see each level.",
+    ),
 ];
 
 impl Figure {
@@ -200,6 +251,8 @@ impl Figure {
         if let Some(d) = self.depth {
             v.depth = d;
         }
+        v.secondary = self.secondary;
+        v.shade_back = self.shade_back;
     }
 }
 
@@ -221,6 +274,27 @@ mod tests {
         assert_eq!(files, listed);
         for f in FIGURES {
             assert!(f.path().is_file(), "{}", f.file);
+        }
+    }
+
+    #[test]
+    fn a_bounce_figure_opens_at_its_scene_s_command_line_and_says_how_far_to_step() {
+        let bounce_figures: Vec<&Figure> =
+            FIGURES.iter().filter(|f| f.secondary.bounces > 0).collect();
+        assert_eq!(bounce_figures.len(), 3);
+        for f in bounce_figures {
+            let text = std::fs::read_to_string(f.path()).expect("scene");
+            let line = format!(
+                "-shadows -shade_back -bounces {} -weight {}",
+                f.secondary.bounces, f.secondary.weight
+            );
+            assert!(text.contains(&line), "{}: {line}", f.file);
+            assert!(f.shade_back && f.secondary.shadows, "{}", f.file);
+            let step = format!(
+                "View › Rays: step the bounces from 0 to {} to see each level",
+                f.secondary.bounces
+            );
+            assert!(f.look[1].starts_with(&step), "{}: {:?}", f.file, f.look);
         }
     }
 }

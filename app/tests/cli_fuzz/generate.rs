@@ -566,22 +566,45 @@ fn animate_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
         [rng.word("1|2|4|8|16").into(), rng.word("1|2|4|8|16").into()]
     };
     g.push(kept(vec![plain("--size"), plain(w), plain(h)]));
-    // Frames too: the default (24) is cheap at these sizes but not at 16384×4.
-    let frames = ctx.pick(rng, FRAMES_OK, FRAMES_BAD);
-    g.push(kept(vec![plain("--frames"), plain(frames)]));
-    let node = ctx.pick(rng, nodes, INDEX_BAD);
-    g.push(group(vec![plain("--node"), plain(node)]));
-    if rng.one_in(2) {
-        let op = ctx.pick(rng, "0|0|1|2", INDEX_BAD);
-        g.push(group(vec![plain("--op"), plain(op)]));
-    }
-    if rng.one_in(2) {
-        let c = ctx.pick(rng, "0|0|1|2|3", INDEX_BAD);
-        g.push(group(vec![plain("--component"), plain(c)]));
-    }
-    for flag in ["--from", "--to"] {
-        let v = ctx.pick(rng, FLOAT_OK, FLOAT_BAD);
-        g.push(group(vec![plain(flag), plain(v)]));
+    if rng.one_in(3) {
+        // A bounce sweep: a few frames at most when it works; ends out of bounds, the wrong
+        // way round or missing, a mix with the op sweep's flags, and hostile weights.
+        for flag in ["--bounces-from", "--bounces-to"] {
+            let v = ctx.pick(rng, "0|1|2|3", "101|-1|4294967296|NaN|1e39|");
+            g.push(group(vec![plain(flag), plain(v)]));
+        }
+        if rng.one_in(3) {
+            g.push(group(vec![plain("--shadows")]));
+        }
+        if rng.one_in(3) {
+            g.push(group(vec![plain("--shade-back")]));
+        }
+        if rng.one_in(3) {
+            let v = ctx.pick(rng, "0|0.01|1", "NaN|inf|-1|");
+            g.push(group(vec![plain("--weight"), plain(v)]));
+        }
+        if ctx.hostile(rng) {
+            let mix = rng.word("--node|--from|--frames|--op");
+            g.push(group(vec![plain(mix), plain("1")]));
+        }
+    } else {
+        // Frames too: the default (24) is cheap at these sizes but not at 16384×4.
+        let frames = ctx.pick(rng, FRAMES_OK, FRAMES_BAD);
+        g.push(kept(vec![plain("--frames"), plain(frames)]));
+        let node = ctx.pick(rng, nodes, INDEX_BAD);
+        g.push(group(vec![plain("--node"), plain(node)]));
+        if rng.one_in(2) {
+            let op = ctx.pick(rng, "0|0|1|2", INDEX_BAD);
+            g.push(group(vec![plain("--op"), plain(op)]));
+        }
+        if rng.one_in(2) {
+            let c = ctx.pick(rng, "0|0|1|2|3", INDEX_BAD);
+            g.push(group(vec![plain("--component"), plain(c)]));
+        }
+        for flag in ["--from", "--to"] {
+            let v = ctx.pick(rng, FLOAT_OK, FLOAT_BAD);
+            g.push(group(vec![plain(flag), plain(v)]));
+        }
     }
     if rng.one_in(4) {
         let v = ctx.pick(rng, "0|1|100|65535", "65536|-1|");

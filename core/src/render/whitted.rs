@@ -62,15 +62,8 @@ pub enum ShadowQuery {
 pub const MAX_BOUNCES: u32 = 100;
 
 impl Default for Secondary {
-    /// The course's defaults: no shadows, no bounces, every ray traced, no fix.
     fn default() -> Self {
-        Secondary {
-            shadows: false,
-            bounces: 0,
-            weight: 0.0,
-            specular_fix: false,
-            shadow_query: ShadowQuery::AnyHit,
-        }
+        Secondary::NONE
     }
 }
 
@@ -81,6 +74,16 @@ impl Default for Secondary {
 pub const MAX_SECONDARY_RAYS: f64 = 65536.0;
 
 impl Secondary {
+    /// The course's defaults: no shadows, no bounces, every ray traced, no fix (a const, for
+    /// tables of settings such as the editor's Lecture figures).
+    pub const NONE: Secondary = Secondary {
+        shadows: false,
+        bounces: 0,
+        weight: 0.0,
+        specular_fix: false,
+        shadow_query: ShadowQuery::AnyHit,
+    };
+
     /// The command line's `-bounces` and `-weight` checked: at most [`MAX_BOUNCES`] levels, a
     /// weight that is a number of 0 or more. The message names the flag as `flag` spells it.
     pub fn check_flags(&self, bounces_flag: &str, weight_flag: &str) -> Result<(), String> {
@@ -121,6 +124,15 @@ impl Secondary {
     /// Refuses settings whose rays would grow past [`MAX_SECONDARY_RAYS`] a pixel in `scene`,
     /// saying why.
     pub fn check_bounded(&self, scene: &CompiledScene) -> Result<(), String> {
+        self.check_bounded_as(scene, "-bounces")
+    }
+
+    /// [`Self::check_bounded`], the message naming the bounce count as `bounces_flag`.
+    pub fn check_bounded_as(
+        &self,
+        scene: &CompiledScene,
+        bounces_flag: &str,
+    ) -> Result<(), String> {
         let worst = self.worst_secondary_rays(scene);
         if worst <= MAX_SECONDARY_RAYS {
             return Ok(());
@@ -142,9 +154,9 @@ impl Secondary {
             format!("about {worst:.1e}")
         };
         Err(format!(
-            "-bounces {}: a material of this scene both reflects and refracts, so one pixel \
-             could trace up to {worst} secondary rays; at most {MAX_SECONDARY_RAYS:.0} are \
-             allowed (-bounces {most} or fewer here)",
+            "{bounces_flag} {}: a material of this scene both reflects and refracts, so one \
+             pixel could trace up to {worst} secondary rays; at most {MAX_SECONDARY_RAYS:.0} \
+             are allowed ({bounces_flag} {most} or fewer here)",
             self.bounces
         ))
     }

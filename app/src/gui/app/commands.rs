@@ -45,20 +45,21 @@ impl TracelabApp {
                 }
             }
             AppCommand::CloseCaption => self.lecture = None,
-            AppCommand::AnimationDialog => match self.doc.selection {
-                Some(Selection::Node(id))
-                    if matches!(
-                        self.doc.scene.graph.get(id).map(|n| &n.kind),
-                        Some(NodeKind::Transform(_))
-                    ) =>
-                {
-                    self.animation = Some(AnimationForm::new(id));
-                }
-                _ => self
-                    .doc
-                    .messages
-                    .warning("Export animation: select a Transform first"),
-            },
+            AppCommand::AnimationDialog => {
+                // An op sweep needs a Transform; without one the form offers the bounce sweep.
+                let transform = match self.doc.selection {
+                    Some(Selection::Node(id))
+                        if matches!(
+                            self.doc.scene.graph.get(id).map(|n| &n.kind),
+                            Some(NodeKind::Transform(_))
+                        ) =>
+                    {
+                        Some(id)
+                    }
+                    _ => None,
+                };
+                self.animation = Some(AnimationForm::new(transform, self.view.secondary.bounces));
+            }
             AppCommand::StartAnimation(form) => {
                 if self.animation_running.is_none() {
                     let size = self.view.fixed_size.unwrap_or(self.viewport.shown_size);
