@@ -354,3 +354,23 @@ fn the_world_diagram_draws_the_ray_trees_reflected_refracted_and_shadow_rays() {
     assert_eq!(count(&shadows_only, Role::Reflected), 0);
     assert!(count(&shadows_only, Role::Shadow) > 0);
 }
+
+/// A scene with mirrors or glass opened with no bounces says where the bounces are set; a
+/// scene without them says nothing (the control), and neither does one opened with bounces.
+#[test]
+fn opening_a_scene_with_mirrors_or_glass_says_where_bounces_are_set() {
+    let says = |h: &Harness<'static, TracelabApp>| {
+        h.state()
+            .doc
+            .messages
+            .iter()
+            .any(|n| n.text.contains("View › Rays (assignments 3–4) sets the bounces"))
+    };
+    let h = harness(mirror_glass("rays-notice"));
+    assert!(says(&h), "no notice on opening mirror_glass.txt");
+    let _ = h.get_by_label_contains("This scene has mirrors or glass");
+    let plain = common::temp_dir("phong", "rays-plain").join("default.txt");
+    std::fs::copy(common::repo().join("scenes/default.txt"), &plain).expect("copy");
+    let h = harness(plain);
+    assert!(!says(&h), "a notice for a scene without mirrors or glass");
+}

@@ -107,6 +107,8 @@ impl TracelabApp {
         if let Some(i) = figure {
             lecture::FIGURES[i].apply(&mut self.view);
             self.lecture = Some(i);
+        } else if !reload {
+            self.tell_about_rays();
         }
         if reload {
             self.doc.select(selection);
@@ -116,6 +118,20 @@ impl TracelabApp {
         }
         self.remember(&path);
         true
+    }
+
+    /// A scene with mirrors or glass, opened while View › Rays traces no bounces, would show
+    /// them dull without saying why: say which setting brings them out.
+    fn tell_about_rays(&mut self) {
+        let bounces_matter = self.doc.scene.materials.iter().any(|m| {
+            m.phong().reflective != glam::Vec3::ZERO || m.phong().transparent != glam::Vec3::ZERO
+        });
+        if bounces_matter && self.view.secondary.bounces == 0 {
+            self.doc.messages.info(
+                "This scene has mirrors or glass: View › Rays (assignments 3–4) sets the \
+                 bounces that show them (0 now, as the course's raytracer starts)",
+            );
+        }
     }
 
     /// Puts `path` first in Open recent, as a canonical path: an entry works from any folder
