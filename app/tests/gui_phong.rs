@@ -360,11 +360,10 @@ fn the_world_diagram_draws_the_ray_trees_reflected_refracted_and_shadow_rays() {
 #[test]
 fn opening_a_scene_with_mirrors_or_glass_says_where_bounces_are_set() {
     let says = |h: &Harness<'static, TracelabApp>| {
-        h.state()
-            .doc
-            .messages
-            .iter()
-            .any(|n| n.text.contains("View › Rays (assignments 3–4) sets the bounces"))
+        h.state().doc.messages.iter().any(|n| {
+            n.text
+                .contains("View › Rays (assignments 3–4) sets the bounces")
+        })
     };
     let h = harness(mirror_glass("rays-notice"));
     assert!(says(&h), "no notice on opening mirror_glass.txt");

@@ -29,6 +29,10 @@ use crate::scene::Phong;
 /// references do not depend on the choice within their tolerance.
 pub const SECONDARY_T_MIN: f32 = 1e-4;
 
+/// How far a shadow ray's origin is lifted off the surface along the normal, relative to the
+/// point's largest coordinate (at least 1): a few thousand ulps of it.
+const SHADOW_LIFT: f32 = 1e-4;
+
 /// Assignment 4's rays beyond the eye ray and assignment 3's optional specular fix: the
 /// course's `-shadows`, `-bounces N`, `-weight W`, and tracelab's `-specular_fix`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -570,7 +574,16 @@ fn light_term<R: Record>(
         if let Some(g) = scene.grid() {
             RayCounts::add(&g.stats.shadow_rays, 1);
         }
-        let shadow = Ray::new(p, l);
+        // Lifted off the surface along its normal as well as started past t_min: a point
+        // computed a hair inside a curved surface would otherwise meet it again at a
+        // grazing angle, farther than any t_min (acne at the terminator of a scaled sphere).
+        let lift = if rules.shadow_t_min_zero {
+            // The mistake is no epsilon at all.
+            Vec3::ZERO
+        } else {
+            n * SHADOW_LIFT * p.abs().max_element().max(1.0)
+        };
+        let shadow = Ray::new(p + lift, l);
         let t_min = if rules.shadow_t_min_zero {
             0.0
         } else {
