@@ -9,9 +9,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use tracelab_core::render::{NormalGap, RenderPlan, normal_rule_gap, render};
-use tracelab_core::{
-    CompiledScene, NormalTransform, ObjectRays, RenderSettings, Scene, SharedFrame,
-};
+use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
 
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
 #[derive(Clone, Debug)]
@@ -62,7 +60,9 @@ pub struct RenderWorker {
     spawn_error: Option<String>,
     last_generation: u64,
     requests: u64,
-    last_key: Option<(u32, u32, bool, ObjectRays, Vec<NormalTransform>, bool)>,
+    /// Every setting of the last request (all of `RenderSettings`, so a new one such as the
+    /// rays of View › Rays can never be left out of it), its normal rules and coarseness.
+    last_key: Option<(RenderSettings, Vec<NormalTransform>, bool)>,
     /// Render only the coarse passes from now on (the view is being dragged); a request with
     /// this off renders the same generation again in full.
     pub coarse_only: bool,
@@ -134,14 +134,7 @@ impl RenderWorker {
         settings: RenderSettings,
         modes: Vec<NormalTransform>,
     ) -> bool {
-        let key = (
-            settings.width,
-            settings.height,
-            settings.shade_back,
-            settings.object_rays,
-            modes.clone(),
-            self.coarse_only,
-        );
+        let key = (settings, modes.clone(), self.coarse_only);
         if generation == self.last_generation && self.last_key.as_ref() == Some(&key) {
             return false;
         }

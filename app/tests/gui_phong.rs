@@ -373,3 +373,41 @@ fn opening_a_scene_with_mirrors_or_glass_says_where_bounces_are_set() {
     let h = harness(plain);
     assert!(!says(&h), "a notice for a scene without mirrors or glass");
 }
+
+/// View › Rays re-renders: the picture on screen is the render with the rays asked for. (Once
+/// the worker's request key left the rays out, so shadows and bounces changed nothing on
+/// screen until another setting did.) The control: the picture before equals a library render
+/// without them, after equals one with them, and the two differ.
+#[test]
+fn setting_the_rays_renders_the_picture_with_them() {
+    let path = mirror_glass("rays-rerender");
+    let mut h = harness(path.clone());
+    let size = (160, 160);
+    let library = |secondary: Secondary| {
+        let mut cache = MeshCache::new();
+        let (scene, _) = tracelab_core::load_scene(&path, &mut cache)
+            .into_result()
+            .expect("loads");
+        let c = CompiledScene::new(&scene);
+        let s = RenderSettings {
+            secondary,
+            ..RenderSettings::new(size.0, size.1)
+        };
+        tracelab_core::render_frame(&c, &s).rgb8(tracelab_core::View::Color, (0.0, 1.0))
+    };
+    let shown = |h: &Harness<'static, TracelabApp>| h.state().shown()[0].rgb8();
+    let before = shown(&h);
+    assert_eq!(before, library(Secondary::default()));
+    let rays = Secondary {
+        shadows: true,
+        bounces: 3,
+        weight: 0.01,
+        ..Secondary::default()
+    };
+    h.state_mut()
+        .queue(tracelab::gui::command::AppCommand::SetRays(rays));
+    settle(&mut h);
+    let after = shown(&h);
+    assert_ne!(after, before, "View › Rays changed nothing on screen");
+    assert_eq!(after, library(rays));
+}
