@@ -440,8 +440,28 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
             if index >= scene.materials.len() {
                 return Err("no such material".into());
             }
+            // A texture's two materials are part of it: removing one would change what the
+            // texture shows, so the texture goes first.
+            if let Some(t) = scene.materials.iter().position(|m| {
+                m.texture
+                    .as_ref()
+                    .is_some_and(|t| t.materials.contains(&(index as u32)))
+            }) {
+                return Err(format!("material {t}, a texture, uses material {index}").into());
+            }
             scene.materials.remove(index);
             let index = index as u32;
+            for t in scene
+                .materials
+                .iter_mut()
+                .filter_map(|m| m.texture.as_mut())
+            {
+                for m in &mut t.materials {
+                    if *m > index {
+                        *m -= 1;
+                    }
+                }
+            }
             for id in g.preorder() {
                 let n = g.node_mut(id);
                 n.material = match n.material {
