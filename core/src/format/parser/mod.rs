@@ -204,7 +204,7 @@ struct Parser<'a> {
     /// (index, offset) of each MaterialIndex, checked once all materials are known.
     material_refs: Vec<(u32, usize)>,
     /// Where each texture's materialIndex lines stand, checked once all materials are known.
-    texture_refs: Vec<texture::TextureRefs>,
+    texture_refs: Vec<TextureRefs>,
     /// (node, offset) of each primitive, for warnings that need the final tree.
     leaf_offsets: Vec<(NodeId, usize)>,
     /// Offset of each object's keyword, indexed by node id (for errors about operands).
@@ -216,6 +216,15 @@ struct Parser<'a> {
     mesh_operands: Vec<(NodeId, CsgOp, usize)>,
     /// Offset of the last TriangleMesh's file name, read by `start_object`.
     last_obj_name: usize,
+}
+
+/// Where a texture's lines stand, for errors found once every material is read.
+#[derive(Clone, Copy, Debug)]
+struct TextureRefs {
+    /// The texture's index in the Materials block.
+    material: usize,
+    /// The value of each `materialIndex` line.
+    at: [usize; 2],
 }
 
 /// Where something stands in a scene file (1-based line and column).

@@ -3,17 +3,8 @@
 //! by kind, `octaves`, `frequency` and `amplitude`.
 
 use super::super::lexer::TokKind;
-use super::{Parser, is_numberlike};
+use super::{Parser, TextureRefs, is_numberlike};
 use crate::scene::{Anchor, Comments, Material, SolidTexture, TextureKind, validate};
-
-/// Where a texture's lines stand, for errors found once every material is read.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct TextureRefs {
-    /// The texture's index in the Materials block.
-    pub material: usize,
-    /// The value of each `materialIndex` line.
-    pub at: [usize; 2],
-}
 
 impl Parser<'_> {
     /// A texture block after its keyword; None (reported) when it is broken, with the
