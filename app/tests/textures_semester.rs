@@ -58,7 +58,7 @@ fn run_texture_lines() -> Vec<(String, RgbImage)> {
         let j = args.iter().position(|a| *a == "-size").expect("-size");
         let size: Vec<u32> = args[j + 1..j + 3]
             .iter()
-            .map(|s| s.parse().unwrap())
+            .map(|s| s.parse().expect("a size"))
             .collect();
         assert_eq!(img.dimensions(), (size[0], size[1]), "{line}");
         out.push((name.to_string(), img));
