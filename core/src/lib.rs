@@ -30,5 +30,5 @@ pub use render::{
 pub use scene::{
     Anchor, Background, Camera, Comments, CsgOp, DEFAULT_MATERIAL_COLOR, Graph, Invalid, Light,
     Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId, NodeKind, Place, Problem, Scene,
-    SceneComments, TransformOp, check_scene,
+    SceneComments, SolidTexture, TextureKind, TransformOp, check_scene,
 };

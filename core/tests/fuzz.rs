@@ -233,6 +233,16 @@ const SCENE_WORDS: &[&str] = &[
     "UniformScale -1",
     "ZRotate -0",
     "Rotate { 0 1 0 30 }",
+    // Solid textures (assignment 6).
+    "Checkerboard",
+    "Noise",
+    "Marble",
+    "Wood",
+    "materialIndex 0",
+    "materialIndex 1",
+    "octaves 3",
+    "frequency 2",
+    "amplitude 1",
 ];
 
 /// One scene case: the properties the harness holds the parser, writer and renderer to.

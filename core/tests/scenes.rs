@@ -89,7 +89,7 @@ fn round_trip(path: &Path, scene: &Scene) -> (String, Scene) {
     (text, back)
 }
 
-/// Words of the course's assignment 1–4 grammar.
+/// Words of the course's assignment 1–4 and 6 grammar.
 const COURSE_WORDS: &[&str] = &[
     "OrthographicCamera",
     "PerspectiveCamera",
@@ -118,6 +118,15 @@ const COURSE_WORDS: &[&str] = &[
     "reflectiveColor",
     "transparentColor",
     "indexOfRefraction",
+    // Assignment 6's solid textures.
+    "Checkerboard",
+    "Noise",
+    "Marble",
+    "Wood",
+    "materialIndex",
+    "octaves",
+    "frequency",
+    "amplitude",
     "Group",
     "numObjects",
     "MaterialIndex",

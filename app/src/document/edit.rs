@@ -440,8 +440,28 @@ pub fn apply_to(scene: &mut Scene, edit: Edit) -> Result<After, Misfit> {
             if index >= scene.materials.len() {
                 return Err("no such material".into());
             }
+            // A texture's two materials are part of it: removing one would change what the
+            // texture shows, so the texture goes first.
+            if let Some(t) = scene.materials.iter().position(|m| {
+                m.texture
+                    .as_ref()
+                    .is_some_and(|t| t.materials.contains(&(index as u32)))
+            }) {
+                return Err(format!("material {t}, a texture, uses material {index}").into());
+            }
             scene.materials.remove(index);
             let index = index as u32;
+            for t in scene
+                .materials
+                .iter_mut()
+                .filter_map(|m| m.texture.as_mut())
+            {
+                for m in &mut t.materials {
+                    if *m > index {
+                        *m -= 1;
+                    }
+                }
+            }
             for id in g.preorder() {
                 let n = g.node_mut(id);
                 n.material = match n.material {
@@ -706,6 +726,36 @@ Group {
             !text.contains("second op")
                 && text.contains("        # first op\n        Translate 1 0 0\n"),
             "{text}"
+        );
+    }
+
+    #[test]
+    fn a_material_a_texture_uses_is_not_removed_and_later_texture_indices_shift() {
+        let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }
+Materials { numMaterials 4 Material { diffuseColor 1 1 1 } Material { diffuseColor 1 0 0 } Material { diffuseColor 0 0 1 }
+Checkerboard { materialIndex 1 materialIndex 2 } }
+Group { numObjects 1 MaterialIndex 3 Plane { normal 0 1 0 offset 0 } }
+";
+        let mut s = tracelab_core::parse_scene(
+            text.as_bytes(),
+            "s.txt",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        )
+        .scene
+        .expect("parses");
+        let refused = apply_to(&mut s, Edit::RemoveMaterial { index: 2 });
+        assert!(
+            refused.is_err_and(|m| m.0 == "material 3, a texture, uses material 2"),
+            "refused"
+        );
+        apply_to(&mut s, Edit::RemoveMaterial { index: 0 }).expect("removes");
+        let t = s.materials[2].texture.as_ref().expect("still a texture");
+        assert_eq!(t.materials, [0, 1]);
+        assert!(tracelab_core::check_scene(&s).is_empty());
+        assert!(
+            written(&s)
+                .contains("Checkerboard {\n        materialIndex 0\n        materialIndex 1\n")
         );
     }
 

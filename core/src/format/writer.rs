@@ -11,7 +11,7 @@ use glam::Vec3;
 use super::MAX_SCENE_BYTES;
 use crate::scene::{
     Anchor, Camera, Comments, Graph, LightKind, MaterialKeyword, NodeId, NodeKind, Problem, Scene,
-    TransformOp, check_scene,
+    SolidTexture, TransformOp, check_scene,
 };
 
 const IND: &str = "    ";
@@ -188,6 +188,10 @@ pub fn write_scene(scene: &Scene) -> String {
     let _ = writeln!(out, "{IND}numMaterials {}", scene.materials.len());
     let in2 = format!("{IND}{IND}");
     for m in &scene.materials {
+        if let Some(t) = &m.texture {
+            write_texture(&mut out, t, &m.comments);
+            continue;
+        }
         let kw = match m.keyword {
             MaterialKeyword::Material => "Material",
             MaterialKeyword::PhongMaterial => "PhongMaterial",
@@ -210,6 +214,40 @@ pub fn write_scene(scene: &Scene) -> String {
     write_graph(&mut out, &scene.graph);
     comment_lines(&mut out, "", &sc.end);
     out
+}
+
+/// A solid texture in the Materials block (`Material::texture`), its own fields only.
+fn write_texture(out: &mut String, t: &SolidTexture, comments: &Comments) {
+    let in2 = format!("{IND}{IND}");
+    comment_lines(out, IND, &comments.before);
+    let _ = writeln!(out, "{IND}{} {{", t.kind.name());
+    let mut inner = Inner::new(comments);
+    if let Some(ops) = &t.transform {
+        inner.field(out, &in2, "Transform");
+        let _ = writeln!(out, "{in2}Transform {{");
+        let in3 = format!("{in2}{IND}");
+        for (i, op) in ops.iter().enumerate() {
+            inner.at(out, &in3, &Anchor::Op(i));
+            write_op(out, &in3, op);
+        }
+        let _ = writeln!(out, "{in2}}}");
+    }
+    for (field, m) in ["materialIndex", "materialIndex#2"].iter().zip(t.materials) {
+        inner.field(out, &in2, field);
+        let _ = writeln!(out, "{in2}materialIndex {m}");
+    }
+    if t.kind.has_octaves() {
+        inner.field(out, &in2, "octaves");
+        let _ = writeln!(out, "{in2}octaves {}", t.octaves);
+    }
+    if t.kind.has_waves() {
+        for (name, v) in [("frequency", t.frequency), ("amplitude", t.amplitude)] {
+            inner.field(out, &in2, name);
+            let _ = writeln!(out, "{in2}{name} {}", num(v));
+        }
+    }
+    inner.finish(out, &in2, &comments.end);
+    let _ = writeln!(out, "{IND}}}");
 }
 
 fn write_camera(out: &mut String, cam: &Camera, comments: &Comments) {

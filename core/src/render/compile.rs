@@ -10,6 +10,7 @@ use glam::{DMat4, Vec3, Vec3A};
 use super::NormalTransform;
 use super::camera::CameraRays;
 use super::csg::CsgTree;
+use super::texture::CompiledTexture;
 use crate::accel::Bvh;
 use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere,
@@ -18,7 +19,7 @@ use crate::geometry::{
 use crate::memory::{OutOfMemory, try_with_capacity};
 use crate::scene::{
     DEFAULT_ATTENUATION, DEFAULT_MATERIAL_COLOR, LightKind, Mesh, MeshSlot, NodeId, NodeKind,
-    Phong, Scene, Walk, unit,
+    Phong, Scene, Walk, unit, validate::MAX_TEXTURE_DEPTH,
 };
 
 /// A point light ready to shade with.
@@ -90,7 +91,11 @@ pub struct CompiledScene {
     pub materials: Vec<Vec3>,
     /// Each material's Phong terms, parallel to `materials`.
     pub phong: Vec<Phong>,
-    /// Some material has a highlight, a mirror or glass: colour needs `whitted.rs`.
+    /// Each material's solid texture, parallel to `materials` (whose entry for a texture is
+    /// unused): a hit on one shades with its two materials (`shading_at`).
+    pub textures: Vec<Option<CompiledTexture>>,
+    /// Some material has a highlight, a mirror or glass, or is a texture: colour needs
+    /// `whitted.rs`.
     pub(super) has_phong_terms: bool,
     pub objects: Vec<Object>,
     pub(super) bvh: Bvh,
@@ -241,7 +246,14 @@ impl CompiledScene {
         let light_indices = directional_at;
         let mut phong: Vec<Phong> = scene.materials.iter().map(|m| m.phong()).collect();
         phong.push(Phong::default());
-        let has_phong_terms = phong.iter().any(|p| !p.is_diffuse_only());
+        let mut textures: Vec<Option<CompiledTexture>> = scene
+            .materials
+            .iter()
+            .map(|m| m.texture.as_ref().map(CompiledTexture::new))
+            .collect();
+        textures.push(None);
+        let has_phong_terms =
+            phong.iter().any(|p| !p.is_diffuse_only()) || textures.iter().any(Option::is_some);
         Ok(CompiledScene {
             camera: CameraRays::new(&scene.camera),
             background: scene.background_color(),
@@ -251,6 +263,7 @@ impl CompiledScene {
             light_indices,
             materials,
             phong,
+            textures,
             has_phong_terms,
             objects,
             bvh,
@@ -558,6 +571,43 @@ impl CompiledScene {
             .get(self.hit_material(hit) as usize)
             .copied()
             .unwrap_or_default()
+    }
+
+    /// The diffuse colour and Phong terms at world point `p` of a hit: its material's own,
+    /// or for a solid texture the material (Checkerboard) or blend (Noise, Marble, Wood) of
+    /// its two that the texture gives at `p`.
+    pub fn hit_shading(&self, hit: &Hit, p: Vec3) -> (Vec3, Phong) {
+        self.shading_at(self.hit_material(hit), p, 0)
+    }
+
+    fn shading_at(&self, material: u32, p: Vec3, depth: usize) -> (Vec3, Phong) {
+        let i = material as usize;
+        let own = || {
+            let kd = self
+                .materials
+                .get(i)
+                .copied()
+                .unwrap_or(DEFAULT_MATERIAL_COLOR);
+            (kd, self.phong.get(i).copied().unwrap_or_default())
+        };
+        let Some(t) = self.textures.get(i).and_then(Option::as_ref) else {
+            return own();
+        };
+        // The rules bound the nesting; a scene compiled unchecked still ends here.
+        if depth > MAX_TEXTURE_DEPTH {
+            return (DEFAULT_MATERIAL_COLOR, Phong::default());
+        }
+        let [a, b] = t.materials;
+        let w = t.weight(p);
+        if w <= 0.0 {
+            return self.shading_at(a, p, depth + 1);
+        }
+        if w >= 1.0 {
+            return self.shading_at(b, p, depth + 1);
+        }
+        let (ka, pa) = self.shading_at(a, p, depth + 1);
+        let (kb, pb) = self.shading_at(b, p, depth + 1);
+        (ka.lerp(kb, w), pa.lerp(&pb, w))
     }
 
     /// The colour `hit_material` names.

@@ -20,6 +20,7 @@ mod rules;
 mod shade;
 mod shade_lanes;
 mod similitude;
+pub mod texture;
 mod whitted;
 
 pub use camera::CameraRays;

@@ -38,7 +38,7 @@ pub fn shade_hit(
 ) -> ShadeInfo {
     let at_hit = scene.ray_for_hit_point(ray, hit, settings.object_rays);
     let normal = scene.world_normal(&at_hit, hit, settings.normal_transform);
-    let kd = scene.hit_color(hit);
+    let kd = scene.hit_shading(hit, at_hit.at(hit.t)).0;
     let back_facing = ray.direction.dot(normal) > 0.0;
     let mut info = ShadeInfo {
         normal,

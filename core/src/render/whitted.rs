@@ -429,8 +429,9 @@ fn color_at<R: Record>(
     weight: f32,
     rec: &mut R,
 ) -> Vec3 {
-    let kd = scene.hit_color(hit);
-    let m = scene.hit_phong(hit);
+    let p = ray.at(hit.t);
+    // A solid texture is evaluated at the world point (its Transform takes it from there).
+    let (kd, m) = scene.hit_shading(hit, p);
     let mut n = normal;
     let back = ray.direction.dot(normal) > 0.0;
     let absolute = back && s.shade_back && rules.shade_back_absolute;
@@ -442,7 +443,6 @@ fn color_at<R: Record>(
             return Vec3::ZERO;
         }
     }
-    let p = ray.at(hit.t);
     let d = ray.direction.normalize_or_zero();
     let ambient = match rules.ambient {
         Ambient::TimesDiffuse => scene.ambient * kd,
@@ -649,7 +649,7 @@ fn opaque_blocker(scene: &CompiledScene, shadow: &Ray, t_min: f32, dist: f32) ->
         let Some(h) = scene.intersect(shadow, from, dist) else {
             return false;
         };
-        if scene.hit_phong(&h).transparent == Vec3::ZERO {
+        if scene.hit_shading(&h, shadow.at(h.t)).1.transparent == Vec3::ZERO {
             return true;
         }
         from = h.t + SECONDARY_T_MIN;

@@ -6,6 +6,7 @@ mod comments;
 mod graph;
 mod mesh;
 mod phong;
+mod texture;
 mod transform;
 pub mod validate;
 pub mod walk;
@@ -15,6 +16,7 @@ pub use comments::{Anchor, Comments, SceneComments};
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
 pub use phong::{PHONG_FIELDS, Phong, PhongField, phong_field};
+pub use texture::{MAX_OCTAVES, SolidTexture, TextureKind};
 pub use transform::{TransformOp, compose, compose_f64, op_matrix_f64, unit};
 pub use validate::{Invalid, Place, Problem, SingularTransform, check_scene};
 pub use walk::{Visit, Walk};
@@ -157,6 +159,9 @@ pub struct Material {
     /// indexOfRefraction), read through [`Material::phong`], and any other name, which the
     /// reader warns about by name and the renderer does not use.
     pub extra: Vec<(String, Vec<f32>)>,
+    /// A solid texture (`Checkerboard`, `Noise`, `Marble`, `Wood`): its colours and Phong
+    /// terms come from the two materials it names, so `diffuse` is zero and `extra` empty.
+    pub texture: Option<SolidTexture>,
     pub comments: Comments,
 }
 
@@ -166,7 +171,16 @@ impl Material {
             diffuse,
             keyword: MaterialKeyword::Material,
             extra: Vec::new(),
+            texture: None,
             comments: Comments::default(),
+        }
+    }
+
+    /// A texture material (its own diffuse colour unused, zero).
+    pub fn textured(texture: SolidTexture) -> Self {
+        Material {
+            texture: Some(texture),
+            ..Material::diffuse(Vec3::ZERO)
         }
     }
 }

@@ -69,6 +69,19 @@ impl Default for Phong {
 
 impl Phong {
     /// Whether this shades exactly as a diffuse-only material (assignments 1 and 2).
+    /// Every term blended linearly, `w` of the way from `self` to `other` (a Noise, Marble
+    /// or Wood texture between two materials).
+    pub fn lerp(&self, other: &Phong, w: f32) -> Phong {
+        let f = |a: f32, b: f32| a + (b - a) * w;
+        Phong {
+            specular: self.specular.lerp(other.specular, w),
+            exponent: f(self.exponent, other.exponent),
+            reflective: self.reflective.lerp(other.reflective, w),
+            transparent: self.transparent.lerp(other.transparent, w),
+            index_of_refraction: f(self.index_of_refraction, other.index_of_refraction),
+        }
+    }
+
     pub fn is_diffuse_only(&self) -> bool {
         self.specular == Vec3::ZERO
             && self.reflective == Vec3::ZERO

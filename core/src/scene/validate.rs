@@ -8,7 +8,8 @@ use super::transform::{compose_f64, op_matrix_f64, unit};
 use super::walk::Walk;
 use super::words::{is_numberlike, is_word};
 use super::{
-    Background, Camera, Graph, Light, LightKind, Material, NodeId, NodeKind, Scene, TransformOp,
+    Background, Camera, Graph, Light, LightKind, MAX_OCTAVES, Material, NodeId, NodeKind, Scene,
+    SolidTexture, TransformOp,
 };
 
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
@@ -211,6 +212,17 @@ pub fn check_background(b: &Background) -> Result<(), Invalid> {
 /// A word the lexer reads back as one token: not empty, no ASCII whitespace, braces, `#`
 /// or NUL (the reader refuses files holding one).
 pub fn check_material(m: &Material) -> Result<(), Invalid> {
+    if let Some(t) = &m.texture {
+        if m.diffuse != Vec3::ZERO || !m.extra.is_empty() {
+            let name = m.extra.first().map_or("diffuseColor", |(n, _)| n.as_str());
+            let msg = format!(
+                "a {} takes its colours from its two materials; it has no {name} of its own",
+                t.kind.name()
+            );
+            return Err(Invalid::new(name, msg));
+        }
+        return check_texture(t);
+    }
     finite3("diffuseColor", m.diffuse)?;
     for (i, (name, values)) in m.extra.iter().enumerate() {
         // The reader takes a number-like word as a value and `obj_file` as a mesh field.
@@ -231,6 +243,136 @@ pub fn check_material(m: &Material) -> Result<(), Invalid> {
         check_phong_field(name, values)?;
     }
     Ok(())
+}
+
+/// A texture's own numbers and Transform (its material indices need the whole list:
+/// [`check_texture_refs`]).
+pub fn check_texture(t: &SolidTexture) -> Result<(), Invalid> {
+    let kind = t.kind.name();
+    if let Some(ops) = &t.transform {
+        for (i, op) in ops.iter().enumerate() {
+            check_op(op).map_err(|e| Invalid { op: Some(i), ..e })?;
+        }
+        if let Some(why) = singular(DMat3::from_mat4(compose_f64(ops))) {
+            return Err(Invalid::new(
+                "Transform",
+                format!("singular transform: the combined operations {why}"),
+            ));
+        }
+    }
+    if !t.kind.has_octaves() && t.octaves != 0 {
+        return Err(Invalid::new("octaves", format!("a {kind} has no octaves")));
+    }
+    if t.octaves > MAX_OCTAVES {
+        let m = format!("octaves must be 0 to {MAX_OCTAVES}, found {}", t.octaves);
+        return Err(Invalid::new("octaves", m));
+    }
+    for (name, v) in [("frequency", t.frequency), ("amplitude", t.amplitude)] {
+        if !t.kind.has_waves() && v != 0.0 {
+            return Err(Invalid::new(name, format!("a {kind} has no {name}")));
+        }
+        finite(name, &[v])?;
+    }
+    Ok(())
+}
+
+/// How deep textures may nest (a texture of textures of …): each level may evaluate both
+/// of its materials, so the work per hit doubles with each one. The course nests 2 deep.
+pub const MAX_TEXTURE_DEPTH: usize = 8;
+
+/// One texture's `materialIndex` at fault: (material, which of its two lines, why).
+pub type TextureRefProblem = (usize, usize, String);
+
+/// Every texture's two material indices: in range, not itself, no loop of textures, and
+/// nested at most [`MAX_TEXTURE_DEPTH`] deep. A loop is reported once, at the line that
+/// closes it.
+pub fn check_texture_refs(materials: &[Material]) -> Vec<TextureRefProblem> {
+    let n = materials.len();
+    let refs = |i: usize| {
+        materials
+            .get(i)
+            .and_then(|m| m.texture.as_ref())
+            .map(|t| t.materials)
+    };
+    let mut out = Vec::new();
+    for i in 0..n {
+        let Some(ab) = refs(i) else { continue };
+        for (slot, &j) in ab.iter().enumerate() {
+            if j as usize >= n {
+                out.push((
+                    i,
+                    slot,
+                    format!(
+                        "materialIndex {j} is out of range: valid indices are 0 to {}",
+                        n - 1
+                    ),
+                ));
+            } else if j as usize == i {
+                out.push((i, slot, format!("materialIndex {j} is this texture itself")));
+            }
+        }
+    }
+    if !out.is_empty() {
+        return out;
+    }
+    // Depth-first over the texture references, iteratively (a hostile file may chain
+    // thousands): 0 unseen, 1 on the path, 2 done with `depth` known.
+    let mut state = vec![0u8; n];
+    let mut depth = vec![0usize; n];
+    for root in 0..n {
+        if state[root] != 0 || refs(root).is_none() {
+            continue;
+        }
+        // (material, next slot to follow)
+        let mut stack = vec![(root, 0usize)];
+        state[root] = 1;
+        while let Some(top) = stack.last_mut() {
+            let (i, k) = *top;
+            top.1 += 1;
+            let ab = refs(i).unwrap_or_default();
+            if k == 2 {
+                let d = ab.iter().map(|&j| depth[j as usize]).max().unwrap_or(0);
+                depth[i] = d + 1;
+                state[i] = 2;
+                stack.pop();
+                if depth[i] > MAX_TEXTURE_DEPTH {
+                    let m = format!(
+                        "textures nest more than {MAX_TEXTURE_DEPTH} deep here (a texture of \
+                         a texture of …)"
+                    );
+                    out.push((i, 0, m));
+                    return out;
+                }
+                continue;
+            }
+            let j = ab[k] as usize;
+            if refs(j).is_none() {
+                continue;
+            }
+            match state[j] {
+                0 => {
+                    state[j] = 1;
+                    stack.push((j, 0));
+                }
+                1 => {
+                    let from = stack.iter().position(|&(m, _)| m == j).unwrap_or(0);
+                    let path: Vec<String> = stack[from..]
+                        .iter()
+                        .map(|&(m, _)| m.to_string())
+                        .chain([j.to_string()])
+                        .collect();
+                    let m = format!(
+                        "materialIndex {j} makes a loop of textures: {}",
+                        path.join(" → ")
+                    );
+                    out.push((i, k, m));
+                    return out;
+                }
+                _ => {}
+            }
+        }
+    }
+    out
 }
 
 /// A Phong field's count of numbers and range; other names pass (the reader warns of them).
@@ -590,6 +732,16 @@ pub fn check_scene(scene: &Scene) -> Vec<Problem> {
             Place::Material(i),
             format!("material {i}"),
         );
+    }
+    for (i, slot, reason) in check_texture_refs(&scene.materials) {
+        out.push(Problem {
+            place: Place::Material(i),
+            field: format!("materialIndex {}", slot + 1),
+            op: None,
+            message: format!("material {i}: {reason}"),
+            reason,
+            incomplete: false,
+        });
     }
     out.extend(check_graph(&scene.graph, scene.materials.len()));
     out

@@ -102,7 +102,8 @@ pub fn ui(
             ui.horizontal(|ui| {
                 ui.add_space(14.0);
                 swatch(ui, m.diffuse);
-                item(ui, Selection::Material(i), format!("Material {i}"));
+                let kind = m.texture.as_ref().map_or("Material", |t| t.kind.name());
+                item(ui, Selection::Material(i), format!("{kind} {i}"));
             });
         }
         ui.separator();

@@ -1,12 +1,15 @@
 //! The top level and its flat blocks: camera, Lights, Background, Materials.
 
+use glam::Vec3;
+
 use super::super::lexer::TokKind;
 use super::Parser;
 use super::fields::block_comments;
 use super::objects::OBJECT_KEYWORDS;
 use crate::scene::phong_field;
 use crate::scene::{
-    Anchor, Background, Camera, Comments, Light, LightKind, Material, MaterialKeyword, validate,
+    Anchor, Background, Camera, Comments, Light, LightKind, Material, MaterialKeyword, TextureKind,
+    validate,
 };
 
 impl Parser<'_> {
@@ -264,6 +267,7 @@ impl Parser<'_> {
             diffuse,
             keyword,
             extra,
+            texture: None,
             comments,
         };
         // Ranges (a negative exponent, an index of refraction ≤ 0), at the field at fault.
@@ -279,7 +283,7 @@ impl Parser<'_> {
             block: "Materials",
             count: "numMaterials",
             noun: "material",
-            expected: "numMaterials, Material or PhongMaterial",
+            expected: "numMaterials, Material, PhongMaterial, Checkerboard, Noise, Marble or Wood",
         };
         let mut count = 0;
         let read = self.read_list_block(&list, off, false, |this, kw, at| match kw {
@@ -290,7 +294,18 @@ impl Parser<'_> {
                 }
                 true
             }
-            _ => false,
+            _ => match TextureKind::from_name(kw) {
+                Some(kind) => {
+                    count += 1;
+                    // A broken one still takes its index (the file is refused anyway), so
+                    // the MaterialIndex lines after it are not reported out of range too.
+                    let m = this.parse_texture_block(kind, at);
+                    this.materials
+                        .push(m.unwrap_or_else(|| Material::diffuse(Vec3::ZERO)));
+                    true
+                }
+                None => false,
+            },
         });
         let Some((comments, declared)) = read else {
             return;

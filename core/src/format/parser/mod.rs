@@ -5,13 +5,15 @@
 //!
 //! In parts: `reader.rs` (tokens, comments and messages), `fields.rs` (a flat block's
 //! `name value…` lines), `blocks.rs` (the top level: camera, lights, background,
-//! materials), `objects.rs` (the object tree and Transform ops); this file holds the
+//! materials), `texture.rs` (the solid textures in Materials), `objects.rs` (the object
+//! tree and Transform ops); this file holds the
 //! parser's state, its entry points and the checks once the whole file is read.
 
 mod blocks;
 mod fields;
 mod objects;
 mod reader;
+mod texture;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -163,6 +165,7 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
         materials: Vec::new(),
         graph: None,
         material_refs: Vec::new(),
+        texture_refs: Vec::new(),
         leaf_offsets: Vec::new(),
         node_offsets: Vec::new(),
         mesh_name_offsets: Vec::new(),
@@ -200,6 +203,8 @@ struct Parser<'a> {
     graph: Option<Graph>,
     /// (index, offset) of each MaterialIndex, checked once all materials are known.
     material_refs: Vec<(u32, usize)>,
+    /// Where each texture's materialIndex lines stand, checked once all materials are known.
+    texture_refs: Vec<TextureRefs>,
     /// (node, offset) of each primitive, for warnings that need the final tree.
     leaf_offsets: Vec<(NodeId, usize)>,
     /// Offset of each object's keyword, indexed by node id (for errors about operands).
@@ -211,6 +216,15 @@ struct Parser<'a> {
     mesh_operands: Vec<(NodeId, CsgOp, usize)>,
     /// Offset of the last TriangleMesh's file name, read by `start_object`.
     last_obj_name: usize,
+}
+
+/// Where a texture's lines stand, for errors found once every material is read.
+#[derive(Clone, Copy, Debug)]
+struct TextureRefs {
+    /// The texture's index in the Materials block.
+    material: usize,
+    /// The value of each `materialIndex` line.
+    at: [usize; 2],
 }
 
 /// Where something stands in a scene file (1-based line and column).
@@ -268,6 +282,11 @@ impl Parser<'_> {
                     format!("MaterialIndex {written} is out of range: {range}"),
                 );
             }
+        }
+        for (i, slot, reason) in validate::check_texture_refs(&self.materials) {
+            let at = self.texture_refs.iter().find(|r| r.material == i);
+            let off = at.map_or(end, |r| r.at[slot.min(1)]);
+            self.error(off, reason);
         }
         if self.camera.is_none() && !self.camera_seen {
             self.error(

@@ -294,7 +294,7 @@ impl Parser<'_> {
 
     /// Parses a transform op after its keyword. Reports and returns None on failure
     /// (including an unknown keyword).
-    fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
+    pub(super) fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
         let op = self.parse_op_numbers(w, off)?;
         if let Err(e) = validate::check_op(&op) {
             self.error(off, e.message);
