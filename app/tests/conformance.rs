@@ -6,17 +6,10 @@
 //! missing.
 
 mod common;
+use common::copy_dir;
 
 use std::path::Path;
 use std::process::Command;
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("create temp dir");
-    for e in std::fs::read_dir(from).expect("read scenes") {
-        let e = e.expect("entry");
-        std::fs::copy(e.path(), to.join(e.file_name())).expect("copy");
-    }
-}
 
 /// (% of pixels within tolerance, largest channel difference)
 fn compare(out: &Path, reference: &Path) -> Result<(f64, u8), String> {

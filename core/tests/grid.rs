@@ -13,30 +13,14 @@
 //! holds no surface.
 
 mod common;
+use common::scene_files;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{UVec3, Vec3};
 use tracelab_core::geometry::Ray;
 use tracelab_core::render::Shape;
 use tracelab_core::{CompiledScene, MeshCache, load_scene};
-
-fn scene_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut todo = vec![dir.to_path_buf()];
-    while let Some(d) = todo.pop() {
-        let rd = std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
-        for p in rd.filter_map(|e| e.ok().map(|e| e.path())) {
-            if p.is_dir() {
-                todo.push(p);
-            } else if p.extension().is_some_and(|e| e == "txt") {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
 
 fn compiled(path: &Path) -> Option<CompiledScene> {
     let (scene, _) = load_scene(path, &mut MeshCache::new()).into_result().ok()?;

@@ -6,31 +6,14 @@
 //! (t_max exclusive, so that hit's t, one ulp either side). Plus the benchmark (`bench`).
 
 mod common;
+use common::scene_files;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use glam::Vec3;
 use tracelab_core::geometry::Ray;
 use tracelab_core::{CompiledScene, MeshCache, load_scene};
-
-/// The `.txt` files under `dir`, its subfolders included, sorted.
-fn scene_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut todo = vec![dir.to_path_buf()];
-    while let Some(d) = todo.pop() {
-        let rd = std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
-        for p in rd.filter_map(|e| e.ok().map(|e| e.path())) {
-            if p.is_dir() {
-                todo.push(p);
-            } else if p.extension().is_some_and(|e| e == "txt") {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
 
 /// The scene compiled, or why tracelab's reader refused it.
 fn compiled(path: &Path) -> Result<CompiledScene, String> {

@@ -9,6 +9,15 @@ use std::path::{Path, PathBuf};
 mod data;
 pub use data::{course_dir, meshes_dir, perf_dir, semester_dir};
 
+/// Copies the files of `from` (not its subfolders) into `to`, made first.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create temp dir");
+    for e in std::fs::read_dir(from).expect("read scenes") {
+        let e = e.expect("entry");
+        std::fs::copy(e.path(), to.join(e.file_name())).expect("copy");
+    }
+}
+
 /// The repository's root (scenes/, assets/).
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
