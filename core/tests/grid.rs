@@ -269,4 +269,30 @@ fn a_sphere_takes_only_the_cells_it_reaches_and_hostile_counts_are_refused() {
     assert!(c.use_grid(UVec3::new(0, 1, 1)).is_err());
     assert!(c.use_grid(UVec3::new(1 << 12, 1 << 12, 2)).is_err());
     assert!(c.use_grid(UVec3::new(256, 256, 256)).is_ok());
+    // A big sphere's box in a 256³ grid is 16.7M pairs: fine; triangles filling the scene's
+    // box, each in every cell, are refused before anything is allocated.
+    let mut tris = String::new();
+    for k in 0..8 {
+        // Each spans the whole box: -1..1 on every axis.
+        let s = if k % 2 == 0 { 1 } else { -1 };
+        tris.push_str(&format!(
+            "Triangle {{ vertex0 -1 -1 -1 vertex1 1 {s} 1 vertex2 {s} 1 -1 }}\n"
+        ));
+    }
+    let text = format!(
+        "OrthographicCamera {{ center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }}\n\
+         Lights {{ numLights 0 }}\nMaterials {{ numMaterials 1 Material {{ diffuseColor 1 0 0 }} }}\n\
+         Group {{ numObjects 8 MaterialIndex 0 {tris} }}\n"
+    );
+    let (scene, _) =
+        tracelab_core::parse_scene(text.as_bytes(), "t.txt", None, &mut MeshCache::new())
+            .into_result()
+            .expect("parses");
+    let mut c = CompiledScene::new(&scene);
+    let e = c
+        .use_grid(UVec3::new(256, 256, 256))
+        .expect_err("too many pairs");
+    assert!(e.to_string().contains("at most 67108864"), "{e}");
+    assert!(c.grid().is_none());
+    assert!(c.use_grid(UVec3::new(64, 64, 64)).is_ok());
 }

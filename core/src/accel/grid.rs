@@ -14,6 +14,11 @@ use super::super::geometry::Aabb;
 /// enough that the offsets array (4 bytes a cell) stays at 64 MiB.
 pub const MAX_CELLS: u64 = 1 << 24;
 
+/// At most this many (cell, entry) pairs: 256 MiB of entries. The handout's grids on the
+/// course's 40k bunny hold about 200,000; a scene of big triangles in a fine grid could ask
+/// for billions, which would take minutes and all the memory there is.
+pub const MAX_ENTRIES: u64 = 1 << 26;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct UniformGrid {
     pub bounds: Aabb,
@@ -91,6 +96,27 @@ impl UniformGrid {
             }
         }
         grid
+    }
+
+    /// How many (cell, entry) pairs `build` could make at most (every cell of each box's
+    /// range), counted without building: checked against [`MAX_ENTRIES`] first.
+    pub fn entries_bound(bounds: Aabb, cells: UVec3, boxes: &[Aabb]) -> u64 {
+        let cells = cells.max(UVec3::ONE);
+        let probe = UniformGrid {
+            bounds,
+            cells,
+            cell_size: bounds.extent().max(Vec3::splat(f32::MIN_POSITIVE)) / cells.as_vec3(),
+            offsets: Vec::new(),
+            entries: Vec::new(),
+        };
+        boxes
+            .iter()
+            .filter_map(|b| probe.cell_range(b))
+            .map(|(lo, hi)| {
+                let n = (hi - lo + UVec3::ONE).as_u64vec3();
+                n.x * n.y * n.z
+            })
+            .fold(0u64, u64::saturating_add)
     }
 
     /// The cells' count along each axis times each other.

@@ -9,7 +9,7 @@ mod triangles;
 mod wide;
 
 pub use bvh::{Bvh, BvhNode};
-pub use grid::{CellVisit, MAX_CELLS, UniformGrid};
+pub use grid::{CellVisit, MAX_CELLS, MAX_ENTRIES, UniformGrid};
 
 /// A broken structural invariant of a BVH, found by `check_invariants` (a tracelab bug, not
 /// a user error): what is wrong, naming the node or primitive.

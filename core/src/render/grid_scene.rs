@@ -11,7 +11,7 @@ use glam::{UVec3, Vec3};
 
 use super::compile::{CompiledScene, Hit, Shape, tie_bound};
 use super::grid_data::{GridScene, RayCounts, WHOLE};
-use crate::accel::{CellVisit, MAX_CELLS, UniformGrid};
+use crate::accel::{CellVisit, MAX_CELLS, MAX_ENTRIES, UniformGrid};
 use crate::geometry::{Aabb, Ray, moller_trumbore};
 
 /// Why a grid could not be built.
@@ -21,6 +21,11 @@ pub enum GridError {
     Zero(u32, u32, u32),
     #[error("-grid: {0} {1} {2} is {3} cells; at most {MAX_CELLS} are allowed")]
     TooMany(u32, u32, u32, u64),
+    #[error(
+        "-grid: {0} {1} {2} would list this scene's objects in up to {3} cells in all; at most \
+         {MAX_ENTRIES} are allowed (fewer cells, or smaller triangles)"
+    )]
+    TooManyEntries(u32, u32, u32, u64),
 }
 
 impl CompiledScene {
@@ -59,6 +64,11 @@ impl CompiledScene {
             .iter()
             .filter(|b| b.is_finite() && !b.is_empty())
             .fold(Aabb::EMPTY, |a, b| a.union(*b));
+        // Before any allocation: big triangles in a fine grid multiply.
+        let most = UniformGrid::entries_bound(bounds, cells, &boxes);
+        if most > MAX_ENTRIES {
+            return Err(GridError::TooManyEntries(x, y, z, most));
+        }
         // A sphere with no transform of its own takes only the cells it reaches, as the
         // handout's pictures show it (a box's corners are empty); a cell the sphere touches
         // within rounding is kept, so no hit is lost.
