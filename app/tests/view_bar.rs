@@ -337,3 +337,88 @@ fn split_shows_the_correct_rule_left_of_the_line_and_the_incorrect_right() {
         "the halves meet at the line"
     );
 }
+
+/// The view bar's controls, as found by label, and their rectangles on screen.
+fn bar_controls(h: &Harness<'static, TracelabApp>) -> Vec<(&'static str, egui::Rect)> {
+    [
+        "Colour",
+        "Normals",
+        "Depth",
+        "All three",
+        "depth min",
+        "max",
+        "Correct (M^-1)^T",
+        "Incorrect M",
+        "compare",
+        "depth t",
+        "shade back",
+        "gizmo & overlays",
+        "world axes",
+        "local axes",
+        "fixed size",
+    ]
+    .into_iter()
+    .map(|l| (l, h.get_by_label(l).rect()))
+    .collect()
+}
+
+/// How many rows the controls sit on: centres within a few points of each other share one.
+fn rows(controls: &[(&str, egui::Rect)]) -> usize {
+    let mut ys: Vec<f32> = controls.iter().map(|(_, r)| r.center().y).collect();
+    ys.sort_by(f32::total_cmp);
+    1 + ys.windows(2).filter(|w| w[1] - w[0] > 6.0).count()
+}
+
+fn window(scene: &Path, width: f32) -> Harness<'static, TracelabApp> {
+    let scene = scene.to_path_buf();
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(width, 800.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: Some(scene),
+                    fixed_size: Some((24, 24)),
+                    ..AppOptions::default()
+                },
+            )
+        });
+    settle(&mut h);
+    h
+}
+
+#[test]
+fn the_view_bar_is_two_rows_at_1280_wide_with_labels_before_their_controls() {
+    let scene = scene_file("bar-rows", SQUASHED);
+    let h = window(&scene, 1280.0);
+    let controls = bar_controls(&h);
+    assert_eq!(rows(&controls), 2, "{controls:?}");
+    let row_of = |l: &str| h.get_by_label(l).rect().center().y;
+    // Each label before its control, on its row.
+    for (label, control) in [
+        ("Compare:", "compare"),
+        ("Depth t:", "depth t"),
+        ("Normal transform:", "Correct (M^-1)^T"),
+        ("View:", "Colour"),
+        ("depth range", "depth min"),
+    ] {
+        let (l, c) = (h.get_by_label(label).rect(), h.get_by_label(control).rect());
+        assert!(
+            l.right() <= c.left() && (l.center().y - c.center().y).abs() < 6.0,
+            "{label} {l:?} is not before {control} {c:?}"
+        );
+    }
+    // The largest angle beside the normal rule, the depth range beside the tabs.
+    let gap = h.get_by_label_contains("° apart").rect().center().y;
+    assert!((gap - row_of("Normal transform:")).abs() < 6.0);
+    assert!((row_of("depth min") - row_of("Depth")).abs() < 6.0);
+    // Two rows down to the smallest window (960 wide).
+    assert_eq!(rows(&bar_controls(&window(&scene, 960.0))), 2);
+    // Control: narrower than any window may be, the same count sees the bar wrap.
+    let narrow = window(&scene, 560.0);
+    assert!(
+        rows(&bar_controls(&narrow)) > 2,
+        "the row count counts rows"
+    );
+}

@@ -62,7 +62,7 @@ impl TracelabApp {
             }
             AppCommand::StartAnimation(form) => {
                 if self.animation_running.is_none() {
-                    let size = self.view.fixed_size.unwrap_or(self.viewport.shown_size);
+                    let size = self.view.fixed_size.unwrap_or(self.viewport.shown_size());
                     let settings = Viewport::settings(&self.view, size);
                     self.animation_running = Some(animation_dialog::Running::start(
                         Arc::new(self.doc.scene.clone()),

@@ -31,7 +31,7 @@ use crate::gui::notifications;
 use crate::gui::panels::pixel_inspector::Inspected;
 use crate::gui::panels::tree::TreeRow;
 use crate::gui::panels::viewport::{Compare, ViewSettings, Viewport};
-use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree};
+use crate::gui::panels::{inspector, pixel_inspector, ray_panel, status, tree, view_bar};
 use crate::gui::ray_diagram::Orbit;
 use crate::gui::settings::Settings;
 use crate::gui::view_tools;

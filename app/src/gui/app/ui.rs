@@ -246,6 +246,12 @@ impl TracelabApp {
             self.messages(ui);
         });
         self.run_commands(&ctx);
+        // The view bar spans the window, so its groups fit two rows at 1280 wide (beside
+        // the side panels they took four).
+        egui::Panel::top("view-bar").show(ui, |ui| {
+            let gap = self.worker.with_published(|p| p.and_then(|p| p.normal_gap));
+            view_bar::ui(ui, &mut self.view, gap);
+        });
         egui::Panel::bottom("status").show(ui, |ui| {
             let note = self
                 .note
@@ -332,10 +338,7 @@ impl TracelabApp {
         let mut pick = None;
         let mut size = (1, 1);
         let view = egui::CentralPanel::default().show(ui, |ui| {
-            let gap = self.worker.with_published(|p| p.and_then(|p| p.normal_gap));
-            Viewport::toolbar(ui, &mut self.view, gap);
             if let Some(f) = self.lecture.and_then(|i| lecture::FIGURES.get(i)) {
-                ui.separator();
                 ui.horizontal(|ui| {
                     ui.vertical(|ui| {
                         ui.strong(f.caption);
@@ -350,8 +353,8 @@ impl TracelabApp {
                         asked.push(AppCommand::CloseCaption);
                     }
                 });
+                ui.separator();
             }
-            ui.separator();
             let area = ui.available_size() + egui::vec2(0.0, reserve);
             size = Viewport::render_size(&self.view, area, ui.pixels_per_point());
             self.render_size = size;

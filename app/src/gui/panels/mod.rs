@@ -9,4 +9,7 @@ pub mod pixel_inspector;
 pub mod ray_panel;
 pub mod status;
 pub mod tree;
+pub mod view_bar;
+pub mod view_settings;
+pub mod view_textures;
 pub mod viewport;

@@ -1,118 +1,20 @@
-//! The render view (centre): view tabs, the normal-transform switch, compare modes, depth
-//! range and size controls, the images themselves (uploaded as textures when the worker has
-//! new pixels), and picking.
+//! The render view (centre): the images themselves, drawn from the texture cache
+//! (`view_textures.rs`) with the gizmo and overlays, and picking. The view bar is
+//! `view_bar.rs`; the settings both share are `view_settings.rs`.
 
-use tracelab_core::render::{MAX_IMAGE_SIDE, NormalGap, Secondary, check_image_size};
-use tracelab_core::{NormalTransform, ObjectRays, RenderSettings, View};
+use tracelab_core::RenderSettings;
 
-use crate::document::{Document, Selection};
+use crate::document::Document;
 use crate::gui::command::AppCommand;
-use crate::gui::gizmo::Axes;
 use crate::gui::on_screen::OnScreen;
 use crate::gui::overlays;
+use crate::gui::panels::view_textures::{self, ViewTextures};
 use crate::gui::view_tools::ViewTools;
-use crate::gui::widgets::number;
-use crate::render_worker::{Published, RenderWorker};
+use crate::render_worker::RenderWorker;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Tab {
-    Color,
-    Normals,
-    Depth,
-    All,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Compare {
-    Off,
-    SideBySide,
-    Split,
-}
-
-/// The render view's settings. Three are kept between runs (`gui/settings.rs`): the tab,
-/// shade back and the depth range; the others start at their defaults every run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ViewSettings {
-    pub tab: Tab,
-    pub compare: Compare,
-    pub normal_transform: NormalTransform,
-    /// How rays enter object space and which t is kept (the lecture's depth question).
-    pub object_rays: ObjectRays,
-    pub shade_back: bool,
-    pub depth: (f32, f32),
-    /// `None`: follow the view's size in pixels.
-    pub fixed_size: Option<(u32, u32)>,
-    /// Split position in compare-split mode, 0..1 from the left.
-    pub split: f32,
-    /// The gizmo's arrows along the world's axes or the Translate's own.
-    pub gizmo_axes: Axes,
-    /// Draw the gizmo and the overlays (outline, axes, lights).
-    pub overlays: bool,
-    /// Shadows, bounces, weight and the specular fix (View › Rays); the course's defaults.
-    pub secondary: Secondary,
-}
-
-impl Default for ViewSettings {
-    fn default() -> Self {
-        ViewSettings {
-            tab: Tab::Color,
-            compare: Compare::Off,
-            normal_transform: NormalTransform::Correct,
-            object_rays: ObjectRays::Unnormalized,
-            shade_back: false,
-            depth: (8.0, 18.0),
-            fixed_size: None,
-            split: 0.5,
-            gizmo_axes: Axes::World,
-            overlays: true,
-            secondary: Secondary::default(),
-        }
-    }
-}
-
-/// The depth-t rules as the toolbar names them.
-pub fn object_rays_label(r: ObjectRays) -> &'static str {
-    match r {
-        ObjectRays::Unnormalized => "unnormalised: t_OS = t_WS",
-        ObjectRays::Normalized => "normalised, t rescaled",
-        ObjectRays::NormalizedNoRescale => "normalised, t not rescaled (bug)",
-    }
-}
-
-impl ViewSettings {
-    /// The renders needed: one, or both rules when comparing.
-    pub fn modes(&self) -> Vec<NormalTransform> {
-        match self.compare {
-            Compare::Off => vec![self.normal_transform],
-            _ => vec![NormalTransform::Correct, NormalTransform::Incorrect],
-        }
-    }
-
-    /// (frame index, view, caption) for each image cell.
-    pub fn cells(&self) -> Vec<(usize, View, &'static str)> {
-        let single = match self.tab {
-            Tab::Color => View::Color,
-            Tab::Normals | Tab::All => View::Normals,
-            Tab::Depth => View::Depth,
-        };
-        match (self.compare, self.tab) {
-            (Compare::Off, Tab::All) => {
-                vec![
-                    (0, View::Color, "Colour"),
-                    (0, View::Normals, "Normals"),
-                    (0, View::Depth, "Depth"),
-                ]
-            }
-            (Compare::Off, _) => vec![(0, single, "")],
-            (Compare::SideBySide, _) => vec![
-                (0, single, "Correct: (M^-1)^T n"),
-                (1, single, "Incorrect: M n"),
-            ],
-            // Split draws both frames into one cell.
-            (Compare::Split, _) => vec![(0, single, "Correct (left) | Incorrect (right)")],
-        }
-    }
-}
+pub use crate::gui::panels::view_settings::{
+    Compare, SplitLine, Tab, ViewSettings, object_rays_label,
+};
 
 /// What a click in the view asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,12 +23,6 @@ pub struct Pick {
     pub x: u32,
     pub row: u32,
 }
-
-/// (render request, frame version, view, depth range bits): what a texture holds. The
-/// request, not the document generation, names the render: a change of normal rule, shade
-/// back or size re-renders the same generation into new frames whose version counters
-/// start again, so a key by generation once kept the old picture on screen.
-type UploadKey = (u64, u64, View, (u32, u32));
 
 /// One image drawn in the view: a texture, the screen rectangle it filled and the part of
 /// the texture shown there (split mode shows a part of each rule's image).
@@ -176,127 +72,22 @@ impl Shown {
     }
 }
 
-/// Texture state: what is on the GPU, so unchanged pixels are not uploaded again.
+/// The view's state: the texture cache, what the last frame drew, the marker and the tools.
 #[derive(Default)]
 pub struct Viewport {
-    textures: Vec<Option<egui::TextureHandle>>,
-    /// Per texture: (request, frame version, view, depth range) last uploaded.
-    uploaded: Vec<Option<UploadKey>>,
-    /// Per texture: the pixels last uploaded, so tests can read what the view shows.
-    images: Vec<Option<std::sync::Arc<egui::ColorImage>>>,
+    textures: ViewTextures,
     /// What the last frame drew: each texture, where, and which part of it.
     drawn: Vec<Drawn>,
-    /// Size of the image shown, in pixels.
-    pub shown_size: (u32, u32),
     /// The pixel being inspected, marked in every image.
     pub marker: Option<(u32, u32)>,
-    /// Generation of the image on screen, for the edit→screen timing log.
-    shown_generation: u64,
     /// Orbit, pan, zoom and the gizmo's drags.
     pub tools: ViewTools,
-    /// The selection's outline, and what it was made from (request, passes, selection,
-    /// generation).
-    outline: Option<egui::TextureHandle>,
-    outline_key: Option<(u64, u64, Option<Selection>, u64)>,
 }
 
 impl Viewport {
-    /// The toolbar. `gap` is the largest angle between the two normal rules over the
-    /// pixels of the image on screen, once computed.
-    pub fn toolbar(ui: &mut egui::Ui, s: &mut ViewSettings, gap: Option<NormalGap>) {
-        ui.horizontal_wrapped(|ui| {
-            for (tab, name) in [
-                (Tab::Color, "Colour"),
-                (Tab::Normals, "Normals"),
-                (Tab::Depth, "Depth"),
-                (Tab::All, "All three"),
-            ] {
-                ui.selectable_value(&mut s.tab, tab, name);
-            }
-            ui.separator();
-            ui.label("Normal transform:");
-            // Compare mode shows both rules, so the switch has nothing to choose there.
-            ui.add_enabled_ui(s.compare == Compare::Off, |ui| {
-                ui.selectable_value(
-                    &mut s.normal_transform,
-                    NormalTransform::Correct,
-                    "Correct (M^-1)^T",
-                );
-                ui.selectable_value(
-                    &mut s.normal_transform,
-                    NormalTransform::Incorrect,
-                    "Incorrect M",
-                );
-            });
-            // Never broken over two rows of the bar.
-            let gap_text = match gap {
-                Some(g) if g.degrees == 0.0 => "0° apart: all similitudes".to_string(),
-                Some(g) => format!("up to {:.2}° apart", g.degrees),
-                None => "…".to_string(),
-            };
-            ui.add(egui::Label::new(gap_text).extend())
-            .on_hover_text("The largest angle between (M^-1)^T·n and M·n over the visible pixels (0 exactly when every transform on screen is a similitude)");
-            ui.separator();
-            egui::ComboBox::from_label("compare")
-                .selected_text(match s.compare {
-                    Compare::Off => "off",
-                    Compare::SideBySide => "side by side",
-                    Compare::Split => "split",
-                })
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut s.compare, Compare::Off, "off");
-                    ui.selectable_value(&mut s.compare, Compare::SideBySide, "side by side");
-                    ui.selectable_value(&mut s.compare, Compare::Split, "split");
-                });
-        });
-        ui.horizontal_wrapped(|ui| {
-            // The lecture's "what to do about the depth t", for both images when comparing.
-            egui::ComboBox::from_label("depth t")
-                .selected_text(object_rays_label(s.object_rays))
-                .show_ui(ui, |ui| {
-                    for r in ObjectRays::ALL {
-                        ui.selectable_value(&mut s.object_rays, r, object_rays_label(r));
-                    }
-                });
-            ui.checkbox(&mut s.overlays, "gizmo & overlays");
-            ui.add_enabled_ui(s.overlays, |ui| {
-                ui.selectable_value(&mut s.gizmo_axes, Axes::World, "world axes")
-                    .on_hover_text("The gizmo's arrows move along the world's x, y and z");
-                ui.selectable_value(&mut s.gizmo_axes, Axes::Local, "local axes")
-                    .on_hover_text("The gizmo's arrows move along the Translate's own axes (its Transform's space)");
-            });
-            ui.separator();
-            ui.checkbox(&mut s.shade_back, "shade back");
-            ui.separator();
-            // "depth" inside the first value, so no lone label ends a row of the bar.
-            number(ui, &mut s.depth.0, |d| d.speed(0.05).prefix("depth min "));
-            number(ui, &mut s.depth.1, |d| d.speed(0.05).prefix("max "));
-            ui.separator();
-            let mut fixed = s.fixed_size.is_some();
-            if ui.checkbox(&mut fixed, "fixed size").changed() {
-                s.fixed_size = fixed.then_some((200, 200));
-            }
-            let error_id = ui.make_persistent_id("fixed-size-refused");
-            if let Some(size) = &mut s.fixed_size {
-                let before = *size;
-                // Whole numbers only: "nan" once parsed, was clamped and became 4096.
-                let parse = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
-                let side = 1..=MAX_IMAGE_SIDE;
-                number(ui, &mut size.0, |d| d.range(side.clone()).custom_parser(parse).suffix(" w"));
-                number(ui, &mut size.1, |d| d.range(side).custom_parser(parse).suffix(" h"));
-                if *size != before {
-                    // The same limits as the command line: refuse, keep the last good size, say why.
-                    let refused = check_image_size(size.0, size.1).err().map(|e| e.to_string());
-                    if refused.is_some() {
-                        *size = before;
-                    }
-                    ui.data_mut(|d| d.insert_temp(error_id, refused));
-                }
-                if let Some(e) = ui.data(|d| d.get_temp::<Option<String>>(error_id)).flatten() {
-                    ui.colored_label(ui.visuals().error_fg_color, e);
-                }
-            }
-        });
+    /// Size of the image shown, in pixels.
+    pub fn shown_size(&self) -> (u32, u32) {
+        self.textures.shown_size
     }
 
     /// The render size for the space available (in points), per the settings.
@@ -351,11 +142,11 @@ impl Viewport {
                 };
                 return;
             };
-            self.upload(&ctx, p, s);
+            self.textures.upload(&ctx, p, s);
             if s.overlays {
-                self.upload_outline(&ctx, p, doc);
+                self.textures.upload_outline(&ctx, p, doc);
             } else {
-                self.outline = None;
+                self.textures.drop_outline();
             }
         });
         let avail = ui.available_size();
@@ -383,8 +174,8 @@ impl Viewport {
                     );
                     img_area.min.y += 18.0;
                 }
-                let tex_i = self.tex_index(frame, view);
-                let Some(Some(tex)) = self.textures.get(tex_i) else {
+                let tex_i = view_textures::index(frame, view);
+                let Some(tex) = self.textures.get(tex_i) else {
                     continue;
                 };
                 let [w, h] = tex.size();
@@ -400,33 +191,37 @@ impl Viewport {
                 let rect = egui::Rect::from_center_size(img_area.center(), size * scale);
                 let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 if s.compare == Compare::Split {
-                    let other = self
-                        .textures
-                        .get(self.tex_index(1, view))
-                        .and_then(Option::as_ref);
-                    let xs = rect.left() + rect.width() * s.split;
-                    let left = egui::Rect::from_min_max(rect.min, egui::pos2(xs, rect.max.y));
-                    let right = egui::Rect::from_min_max(egui::pos2(xs, rect.min.y), rect.max);
-                    let luv =
-                        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(s.split, 1.0));
-                    let ruv =
-                        egui::Rect::from_min_max(egui::pos2(s.split, 0.0), egui::pos2(1.0, 1.0));
-                    painter.image(tex.id(), left, luv, egui::Color32::WHITE);
-                    self.drawn.push(Drawn::clipped(tex_i, left, luv, cell));
+                    let other_i = view_textures::index(1, view);
+                    let other = self.textures.get(other_i);
+                    // The correct rule's part (left or above the line) and the incorrect one's.
+                    let (first, second) = split_halves(rect, s.split_line, s.split);
+                    let (first_uv, second_uv) = split_halves(uv, s.split_line, s.split);
+                    painter.image(tex.id(), first, first_uv, egui::Color32::WHITE);
+                    self.drawn
+                        .push(Drawn::clipped(tex_i, first, first_uv, cell));
                     if let Some(o) = other {
-                        painter.image(o.id(), right, ruv, egui::Color32::WHITE);
-                        let texture = self.tex_index(1, view);
-                        self.drawn.push(Drawn::clipped(texture, right, ruv, cell));
+                        painter.image(o.id(), second, second_uv, egui::Color32::WHITE);
+                        self.drawn
+                            .push(Drawn::clipped(other_i, second, second_uv, cell));
                     }
-                    painter.vline(
-                        xs,
-                        rect.y_range(),
-                        egui::Stroke::new(2.0, egui::Color32::YELLOW),
-                    );
+                    let line = egui::Stroke::new(2.0, egui::Color32::YELLOW);
+                    match s.split_line {
+                        SplitLine::Vertical => {
+                            painter.vline(first.right(), rect.y_range(), line);
+                        }
+                        SplitLine::Horizontal => {
+                            painter.hline(rect.x_range(), first.bottom(), line);
+                        }
+                    }
                     if resp.dragged()
                         && let Some(pos) = resp.interact_pointer_pos()
                     {
-                        s.split = ((pos.x - rect.left()) / rect.width()).clamp(0.0, 1.0);
+                        let t = (pos - rect.min) / rect.size();
+                        s.split = match s.split_line {
+                            SplitLine::Vertical => t.x,
+                            SplitLine::Horizontal => t.y,
+                        }
+                        .clamp(0.0, 1.0);
                     }
                 } else {
                     painter.image(tex.id(), rect, uv, egui::Color32::WHITE);
@@ -439,7 +234,7 @@ impl Viewport {
                     .cell(ui, &resp, ci, &view, doc, s.gizmo_axes, &surface, out);
                 if s.overlays {
                     let painter = painter.with_clip_rect(rect.intersect(painter.clip_rect()));
-                    if let Some(o) = &self.outline {
+                    if let Some(o) = self.textures.outline() {
                         painter.image(o.id(), rect, uv, egui::Color32::WHITE);
                     }
                     overlays::triad(&painter, &view.basis, rect);
@@ -473,7 +268,11 @@ impl Viewport {
                 {
                     let u = (pos.x - rect.left()) / rect.width();
                     let v = (pos.y - rect.top()) / rect.height();
-                    let frame = if s.compare == Compare::Split && u > s.split {
+                    let across = match s.split_line {
+                        SplitLine::Vertical => u,
+                        SplitLine::Horizontal => v,
+                    };
+                    let frame = if s.compare == Compare::Split && across > s.split {
                         1
                     } else {
                         frame
@@ -487,44 +286,13 @@ impl Viewport {
         pick
     }
 
-    /// The outline of the selection, made again when the pixels or the selection change.
-    fn upload_outline(&mut self, ctx: &egui::Context, p: &Published, doc: &Document) {
-        // The image on screen stays the previous one until a pass is done; so does its outline.
-        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else {
-            return;
-        };
-        // Once a pass, not once a tile: it runs over every pixel.
-        let key = Some((
-            p.job.request,
-            p.passes_done as u64,
-            doc.selection,
-            doc.generation,
-        ));
-        if self.outline_key == key {
-            return;
-        }
-        self.outline_key = key;
-        let ids = match doc.selection {
-            Some(Selection::Node(id)) => overlays::subtree_ids(&doc.scene, id),
-            _ => Default::default(),
-        };
-        let image = overlays::outline(&frame.lock(), &ids);
-        self.outline = image.map(|img| match self.outline.take() {
-            Some(mut t) => {
-                t.set(img, egui::TextureOptions::NEAREST);
-                t
-            }
-            None => ctx.load_texture("selection-outline", img, egui::TextureOptions::NEAREST),
-        });
-    }
-
     /// The images the last frame drew, in drawing order, with the pixels their textures
     /// held: what the user sees, not what the renderer has.
     pub fn shown(&self) -> Vec<Shown> {
         self.drawn
             .iter()
             .filter_map(|d| {
-                let image = self.images.get(d.texture)?.clone()?;
+                let image = self.textures.image(d.texture)?;
                 Some(Shown {
                     rect: d.rect,
                     uv: d.uv,
@@ -532,79 +300,6 @@ impl Viewport {
                 })
             })
             .collect()
-    }
-
-    fn tex_index(&self, frame: usize, view: View) -> usize {
-        frame * 3
-            + match view {
-                View::Color => 0,
-                View::Normals => 1,
-                View::Depth => 2,
-            }
-    }
-
-    /// Uploads the views the cells need whenever their pixels changed. The previous image
-    /// stays until a new render has completed its first (coarse) pass.
-    fn upload(&mut self, ctx: &egui::Context, p: &Published, s: &ViewSettings) {
-        if p.passes_done == 0 {
-            return;
-        }
-        let mut need: Vec<(usize, View)> = s.cells().iter().map(|&(f, v, _)| (f, v)).collect();
-        if s.compare == Compare::Split {
-            need.extend(s.cells().iter().map(|&(_, v, _)| (1, v)));
-        }
-        for (frame_i, view) in need {
-            let Some(frame) = p.frames.get(frame_i) else {
-                continue;
-            };
-            let i = self.tex_index(frame_i, view);
-            if self.textures.len() <= i {
-                self.textures.resize_with(i + 1, || None);
-                self.uploaded.resize(i + 1, None);
-                self.images.resize(i + 1, None);
-            }
-            let depth_key = (s.depth.0.to_bits(), s.depth.1.to_bits());
-            let key = Some((p.job.request, frame.version(), view, depth_key));
-            if self.uploaded[i] == key {
-                continue;
-            }
-            let (w, h, rgba) = {
-                let f = frame.lock();
-                (f.width, f.height, f.rgba8(view, s.depth))
-            };
-            if w == 0 || h == 0 {
-                continue;
-            }
-            let image = std::sync::Arc::new(egui::ColorImage::from_rgba_unmultiplied(
-                [w as usize, h as usize],
-                &rgba,
-            ));
-            self.images[i] = Some(image.clone());
-            match &mut self.textures[i] {
-                Some(t) => t.set(image, egui::TextureOptions::NEAREST),
-                slot => {
-                    *slot = Some(ctx.load_texture(
-                        format!("view-{i}"),
-                        image,
-                        egui::TextureOptions::NEAREST,
-                    ))
-                }
-            }
-            self.uploaded[i] = key;
-            self.shown_size = (w, h);
-        }
-        if p.job.generation != self.shown_generation {
-            self.shown_generation = p.job.generation;
-            if log::log_enabled!(target: crate::logging::TIMES, log::Level::Info) {
-                log::info!(
-                    target: crate::logging::TIMES,
-                    "generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
-                    p.job.generation,
-                    p.job.submitted.elapsed().as_secs_f64() * 1e3,
-                    ctx.input(|i| i.unstable_dt) * 1e3
-                );
-            }
-        }
     }
 
     /// The settings the worker should render with.
@@ -617,6 +312,27 @@ impl Viewport {
             object_rays: s.object_rays,
             variant: None,
             secondary: s.secondary,
+        }
+    }
+}
+
+/// `rect` cut by the split line at `at` (0..1 from the left or the top): the part before the
+/// line (the correct rule's) and the part after it.
+fn split_halves(rect: egui::Rect, line: SplitLine, at: f32) -> (egui::Rect, egui::Rect) {
+    match line {
+        SplitLine::Vertical => {
+            let x = rect.left() + rect.width() * at;
+            (
+                egui::Rect::from_min_max(rect.min, egui::pos2(x, rect.max.y)),
+                egui::Rect::from_min_max(egui::pos2(x, rect.min.y), rect.max),
+            )
+        }
+        SplitLine::Horizontal => {
+            let y = rect.top() + rect.height() * at;
+            (
+                egui::Rect::from_min_max(rect.min, egui::pos2(rect.max.x, y)),
+                egui::Rect::from_min_max(egui::pos2(rect.min.x, y), rect.max),
+            )
         }
     }
 }

@@ -1,0 +1,158 @@
+//! The render view's texture cache: the worker's pixels uploaded to the GPU when they
+//! change (and only then), the pixels each texture holds (what the user sees), and the
+//! selection's outline.
+
+use tracelab_core::View;
+
+use crate::document::{Document, Selection};
+use crate::gui::overlays;
+use crate::gui::panels::view_settings::{Compare, ViewSettings};
+use crate::render_worker::Published;
+
+/// (render request, frame version, view, depth range bits): what a texture holds. The
+/// request, not the document generation, names the render: a change of normal rule, shade
+/// back or size re-renders the same generation into new frames whose version counters
+/// start again, so a key by generation once kept the old picture on screen.
+type UploadKey = (u64, u64, View, (u32, u32));
+
+/// Texture state: what is on the GPU, so unchanged pixels are not uploaded again.
+#[derive(Default)]
+pub struct ViewTextures {
+    textures: Vec<Option<egui::TextureHandle>>,
+    /// Per texture: (request, frame version, view, depth range) last uploaded.
+    uploaded: Vec<Option<UploadKey>>,
+    /// Per texture: the pixels last uploaded, so tests can read what the view shows.
+    images: Vec<Option<std::sync::Arc<egui::ColorImage>>>,
+    /// Size of the image shown, in pixels.
+    pub shown_size: (u32, u32),
+    /// Generation of the image on screen, for the edit→screen timing log.
+    shown_generation: u64,
+    /// The selection's outline, and what it was made from (request, passes, selection,
+    /// generation).
+    outline: Option<egui::TextureHandle>,
+    outline_key: Option<(u64, u64, Option<Selection>, u64)>,
+}
+
+/// The texture slot of a frame's view.
+pub fn index(frame: usize, view: View) -> usize {
+    frame * 3
+        + match view {
+            View::Color => 0,
+            View::Normals => 1,
+            View::Depth => 2,
+        }
+}
+
+impl ViewTextures {
+    pub fn get(&self, i: usize) -> Option<&egui::TextureHandle> {
+        self.textures.get(i).and_then(Option::as_ref)
+    }
+
+    /// The pixels texture `i` holds.
+    pub fn image(&self, i: usize) -> Option<std::sync::Arc<egui::ColorImage>> {
+        self.images.get(i)?.clone()
+    }
+
+    pub fn outline(&self) -> Option<&egui::TextureHandle> {
+        self.outline.as_ref()
+    }
+
+    pub fn drop_outline(&mut self) {
+        self.outline = None;
+    }
+
+    /// The outline of the selection, made again when the pixels or the selection change.
+    pub fn upload_outline(&mut self, ctx: &egui::Context, p: &Published, doc: &Document) {
+        // The image on screen stays the previous one until a pass is done; so does its outline.
+        let Some(frame) = p.frames.first().filter(|_| p.passes_done > 0) else {
+            return;
+        };
+        // Once a pass, not once a tile: it runs over every pixel.
+        let key = Some((
+            p.job.request,
+            p.passes_done as u64,
+            doc.selection,
+            doc.generation,
+        ));
+        if self.outline_key == key {
+            return;
+        }
+        self.outline_key = key;
+        let ids = match doc.selection {
+            Some(Selection::Node(id)) => overlays::subtree_ids(&doc.scene, id),
+            _ => Default::default(),
+        };
+        let image = overlays::outline(&frame.lock(), &ids);
+        self.outline = image.map(|img| match self.outline.take() {
+            Some(mut t) => {
+                t.set(img, egui::TextureOptions::NEAREST);
+                t
+            }
+            None => ctx.load_texture("selection-outline", img, egui::TextureOptions::NEAREST),
+        });
+    }
+
+    /// Uploads the views the cells need whenever their pixels changed. The previous image
+    /// stays until a new render has completed its first (coarse) pass.
+    pub fn upload(&mut self, ctx: &egui::Context, p: &Published, s: &ViewSettings) {
+        if p.passes_done == 0 {
+            return;
+        }
+        let mut need: Vec<(usize, View)> = s.cells().iter().map(|&(f, v, _)| (f, v)).collect();
+        if s.compare == Compare::Split {
+            need.extend(s.cells().iter().map(|&(_, v, _)| (1, v)));
+        }
+        for (frame_i, view) in need {
+            let Some(frame) = p.frames.get(frame_i) else {
+                continue;
+            };
+            let i = index(frame_i, view);
+            if self.textures.len() <= i {
+                self.textures.resize_with(i + 1, || None);
+                self.uploaded.resize(i + 1, None);
+                self.images.resize(i + 1, None);
+            }
+            let depth_key = (s.depth.0.to_bits(), s.depth.1.to_bits());
+            let key = Some((p.job.request, frame.version(), view, depth_key));
+            if self.uploaded[i] == key {
+                continue;
+            }
+            let (w, h, rgba) = {
+                let f = frame.lock();
+                (f.width, f.height, f.rgba8(view, s.depth))
+            };
+            if w == 0 || h == 0 {
+                continue;
+            }
+            let image = std::sync::Arc::new(egui::ColorImage::from_rgba_unmultiplied(
+                [w as usize, h as usize],
+                &rgba,
+            ));
+            self.images[i] = Some(image.clone());
+            match &mut self.textures[i] {
+                Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+                slot => {
+                    *slot = Some(ctx.load_texture(
+                        format!("view-{i}"),
+                        image,
+                        egui::TextureOptions::NEAREST,
+                    ))
+                }
+            }
+            self.uploaded[i] = key;
+            self.shown_size = (w, h);
+        }
+        if p.job.generation != self.shown_generation {
+            self.shown_generation = p.job.generation;
+            if log::log_enabled!(target: crate::logging::TIMES, log::Level::Info) {
+                log::info!(
+                    target: crate::logging::TIMES,
+                    "generation {} on screen {:.1} ms after the edit (last frame took {:.1} ms)",
+                    p.job.generation,
+                    p.job.submitted.elapsed().as_secs_f64() * 1e3,
+                    ctx.input(|i| i.unstable_dt) * 1e3
+                );
+            }
+        }
+    }
+}
