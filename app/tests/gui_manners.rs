@@ -294,6 +294,49 @@ fn notices_are_typed_counted_once_and_never_move_the_layout() {
     assert_eq!(layout(&h), before);
 }
 
+/// The question asked when the file changes on disk under unsaved edits is an overlay like
+/// the notices: the picture, the tree and the inspector stay where they were.
+#[test]
+fn the_file_changed_question_never_moves_the_layout() {
+    let path = sheared("disk-changed");
+    let mut h = harness(path.clone());
+    let (id, t) = transforms(h.state())[1];
+    h.state_mut().apply(Edit::SetTransformOp {
+        node: id,
+        index: 0,
+        op: TransformOp::Translate(Vec3::new(2.0, t.y, t.z)),
+    });
+    h.state_mut().doc.end_gesture();
+    settle(&mut h);
+    let before = layout(&h);
+    // Someone edits the file beside the app.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let text = std::fs::read_to_string(&path).expect("read");
+    std::fs::write(&path, format!("{text}\n# edited elsewhere\n")).expect("write");
+    let start = std::time::Instant::now();
+    while !h.state().disk_changed {
+        h.step();
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(5),
+            "the change was not seen"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    settle(&mut h);
+    // Shown (the positive control: the question is on screen)…
+    let _ = h.get_by_label_contains("changed on disk");
+    // …over the view, so nothing has moved.
+    assert_eq!(layout(&h), before, "the question moved the layout");
+    // Keep mine: the question goes, the edit stays.
+    h.get_by_label("Keep mine").click();
+    h.step();
+    h.step();
+    assert!(!h.state().disk_changed && h.state().doc.is_dirty());
+    assert!(h.query_by_label_contains("changed on disk").is_none());
+    assert_eq!(translate_x(h.state(), id), 2.0);
+    assert_eq!(layout(&h), before);
+}
+
 /// Bug 2: the first click opens the dock and the view shrinks; the story must still be that
 /// of the pixel that was under the pointer, not of the same fraction of a smaller image.
 #[test]

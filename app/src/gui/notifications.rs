@@ -1,6 +1,7 @@
 //! The document's notices as notifications over the view's corner: an overlay, so a new one
 //! never moves a widget the user is about to click. Info fades after a while; warnings and
-//! errors stay until dismissed.
+//! errors stay until dismissed. The question asked when the open file changes on disk under
+//! unsaved edits is such an overlay too, at the view's top.
 
 use std::time::Duration;
 
@@ -78,4 +79,42 @@ pub fn ui(ctx: &egui::Context, notices: &mut Notices, over: egui::Rect) {
     } else if let Some(i) = dismiss {
         notices.dismiss(i);
     }
+}
+
+/// The answer to the file-changed question.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DiskAnswer {
+    /// Read the file again, losing the edits.
+    Reload,
+    /// Keep the edits; the file on disk counts as seen.
+    KeepMine,
+}
+
+/// "The file changed on disk, and you have unsaved edits", with its two answers, over the
+/// top of `over` (the view): it covers the picture's top edge instead of pushing the whole
+/// window down a row.
+pub fn disk_changed(ctx: &egui::Context, over: egui::Rect) -> Option<DiskAnswer> {
+    let mut answer = None;
+    egui::Area::new(egui::Id::unique("tracelab-disk-changed"))
+        .order(egui::Order::Foreground)
+        .pivot(egui::Align2::CENTER_TOP)
+        .fixed_pos(over.center_top() + egui::vec2(0.0, 8.0))
+        .constrain_to(over)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.colored_label(
+                        colour(ui, Level::Warning),
+                        "The file changed on disk, and you have unsaved edits.",
+                    );
+                    if ui.button("Reload (lose edits)").clicked() {
+                        answer = Some(DiskAnswer::Reload);
+                    }
+                    if ui.button("Keep mine").clicked() {
+                        answer = Some(DiskAnswer::KeepMine);
+                    }
+                });
+            });
+        });
+    answer
 }

@@ -303,6 +303,17 @@ impl TracelabApp {
     }
 
     /// Watches the file: reload quietly when nothing is unsaved, else ask.
+    /// "Keep mine" to the file-changed question: the edits stay, and the file as it is now
+    /// on disk counts as seen.
+    pub(super) fn keep_mine(&mut self) {
+        self.disk_changed = false;
+        self.doc.disk_stamp = self
+            .doc
+            .path
+            .as_deref()
+            .and_then(|p| std::fs::metadata(p).and_then(|m| m.modified()).ok());
+    }
+
     pub(super) fn watch_disk(&mut self) {
         self.file_watch
             .follow(self.doc.path.as_deref(), self.repaint.clone());

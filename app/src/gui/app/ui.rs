@@ -1,6 +1,7 @@
 //! One frame of the window: menus, panels, the view, the pixel inspector's story.
 
 use super::*;
+use crate::gui::notifications::DiskAnswer;
 
 impl TracelabApp {
     /// Inspects a pixel of the image last published (the image on screen) and selects
@@ -157,26 +158,8 @@ impl TracelabApp {
         {
             self.cancel_loading();
         }
-        if self.disk_changed {
-            ui.horizontal(|ui| {
-                ui.colored_label(
-                    ui.visuals().warn_fg_color,
-                    "The file changed on disk, and you have unsaved edits.",
-                );
-                if ui.button("Reload (lose edits)").clicked() {
-                    self.queue(AppCommand::Reload);
-                }
-                if ui.button("Keep mine").clicked() {
-                    self.disk_changed = false;
-                    self.doc.disk_stamp = self
-                        .doc
-                        .path
-                        .as_deref()
-                        .and_then(|p| std::fs::metadata(p).and_then(|m| m.modified()).ok());
-                }
-            });
-        }
-        // The document's notices are drawn over the view (`notifications::ui`).
+        // The document's notices and the file-changed question are drawn over the view
+        // (`notifications`), so they never push the layout down.
     }
 
     /// One frame of UI, shared by eframe and tests.
@@ -369,6 +352,13 @@ impl TracelabApp {
             );
         });
         notifications::ui(&ctx, &mut self.doc.messages, view.response.rect);
+        if self.disk_changed {
+            match notifications::disk_changed(&ctx, view.response.rect) {
+                Some(DiskAnswer::Reload) => self.queue(AppCommand::Reload),
+                Some(DiskAnswer::KeepMine) => self.keep_mine(),
+                None => {}
+            }
+        }
         self.commands.extend(asked);
         if let Some(p) = pick {
             self.queue(AppCommand::Inspect {
