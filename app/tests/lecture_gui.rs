@@ -294,3 +294,75 @@ fn a_bounce_figure_opens_with_its_rays_and_a_plain_figure_puts_them_back() {
     assert_eq!(h.state().view.secondary, Secondary::NONE);
     assert!(!h.state().view.shade_back);
 }
+
+/// Pixels of `s`'s shown part that are the sheared sphere's red and the box's green.
+fn red_and_green(s: &tracelab::gui::panels::viewport::Shown) -> (usize, usize) {
+    let [w, h] = s.size();
+    let (x0, x1) = (
+        (s.uv.min.x * w as f32) as usize,
+        (s.uv.max.x * w as f32) as usize,
+    );
+    let (y0, y1) = (
+        (s.uv.min.y * h as f32) as usize,
+        (s.uv.max.y * h as f32) as usize,
+    );
+    let rgb = s.rgb8();
+    let (mut red, mut green) = (0, 0);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let i = (y * w + x) * 3;
+            let (r, g) = (rgb[i] as i32, rgb[i + 1] as i32);
+            red += usize::from(r > g + 20 && r > 40);
+            green += usize::from(g > r + 20 && g > 40);
+        }
+    }
+    (red, green)
+}
+
+/// "Incorrect vs correct normal transformation" opens split so that each of its two objects
+/// (placed side by side) is seen under both rules: each half of the split shows some of both.
+#[test]
+fn the_normal_transform_figure_shows_each_object_under_both_rules() {
+    let i = tracelab::gui::lecture::FIGURES
+        .iter()
+        .position(|f| f.file == "normal_transform.txt")
+        .expect("in the menu");
+    let mut h = harness((64, 48));
+    settle(&mut h);
+    h.state_mut().queue(AppCommand::OpenLecture(i));
+    settle(&mut h);
+    let shown = h.state().shown();
+    assert_eq!(shown.len(), 2, "the two rules' parts");
+    let (correct, incorrect) = (red_and_green(&shown[0]), red_and_green(&shown[1]));
+    // The colours are told apart at all (control: the whole picture has both objects).
+    assert!(correct.0 + incorrect.0 > 50 && correct.1 + incorrect.1 > 50);
+    for (rule, (red, green)) in [("correct", correct), ("incorrect", incorrect)] {
+        assert!(
+            red > 20 && green > 20,
+            "the {rule} part shows {red} red (sphere) and {green} green (box) pixels"
+        );
+    }
+    // A click below the line inspects the incorrect rule's image; above it, the correct one.
+    for (part, frame) in [(&shown[1], 1), (&shown[0], 0)] {
+        let c = part.rect.center();
+        h.hover_at(c);
+        h.step();
+        h.event(egui::Event::PointerButton {
+            pos: c,
+            button: egui::PointerButton::Primary,
+            pressed: true,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.event(egui::Event::PointerButton {
+            pos: c,
+            button: egui::PointerButton::Primary,
+            pressed: false,
+            modifiers: egui::Modifiers::NONE,
+        });
+        for _ in 0..3 {
+            h.step();
+        }
+        let at = h.state().inspected.clone().expect("a pixel inspected");
+        assert_eq!(at.frame, frame, "clicked at {c:?}");
+    }
+}

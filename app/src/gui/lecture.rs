@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use tracelab_core::render::Secondary;
 use tracelab_core::{NormalTransform, ObjectRays};
 
-use crate::gui::panels::viewport::{Compare, Tab, ViewSettings};
+use crate::gui::panels::viewport::{Compare, SplitLine, Tab, ViewSettings};
 
 pub struct Figure {
     /// File name in scenes/lecture/.
@@ -18,6 +18,8 @@ pub struct Figure {
     pub look: [&'static str; 2],
     pub tab: Tab,
     pub compare: Compare,
+    /// Which way a split compare's line runs (through the figure's objects).
+    pub split_line: SplitLine,
     pub normal_transform: NormalTransform,
     pub object_rays: ObjectRays,
     /// The depth view's range, where the figure uses it.
@@ -36,6 +38,7 @@ const fn fig(file: &'static str, caption: &'static str, look: [&'static str; 2])
         look,
         tab: Tab::Color,
         compare: Compare::Off,
+        split_line: SplitLine::Vertical,
         normal_transform: NormalTransform::Correct,
         object_rays: ObjectRays::Unnormalized,
         depth: None,
@@ -117,13 +120,16 @@ pub static FIGURES: &[Figure] = &[
             ],
         )
     },
+    // The sphere and the box sit side by side, so the line runs across both: each is seen
+    // under both rules (a vertical line gave one object to each rule).
     Figure {
         compare: Compare::Split,
+        split_line: SplitLine::Horizontal,
         ..fig(
             "normal_transform.txt",
             "Incorrect vs correct normal transformation",
             [
-                "Left of the yellow line (M^-1)^T·n, right M·n: on the right the shading slides off the sheared shapes.",
+                "Above the yellow line (M^-1)^T·n, below it M·n: below, the shading slides off the sheared shapes.",
                 "Click a pixel: the Ray panel draws both normals; the toolbar gives their largest angle.",
             ],
         )
@@ -246,6 +252,10 @@ impl Figure {
     pub fn apply(&self, v: &mut ViewSettings) {
         v.tab = self.tab;
         v.compare = self.compare;
+        if self.compare == Compare::Split {
+            v.split_line = self.split_line;
+            v.split = 0.5;
+        }
         v.normal_transform = self.normal_transform;
         v.object_rays = self.object_rays;
         if let Some(d) = self.depth {
