@@ -366,3 +366,73 @@ fn the_normal_transform_figure_shows_each_object_under_both_rules() {
         assert_eq!(at.frame, frame, "clicked at {c:?}");
     }
 }
+
+/// Every label the Ray panel's diagrams draw, found on screen, with where it is.
+fn diagram_labels(h: &Harness<'static, TracelabApp>) -> Vec<(String, egui::Rect)> {
+    let mut out = Vec::new();
+    for text in ["hit", "(M^-1)^T n", "M n", "n", "M^-1 o"] {
+        for n in h.query_all_by_label(text) {
+            out.push((text.to_string(), n.rect()));
+        }
+    }
+    for text in ["t = ", "M^-1 d, length", "ray origin", "L0"] {
+        for n in h.query_all_by_label_contains(text) {
+            out.push((text.to_string(), n.rect()));
+        }
+    }
+    out
+}
+
+fn assert_apart(labels: &[(String, egui::Rect)]) {
+    for (i, (a, ra)) in labels.iter().enumerate() {
+        for (b, rb) in &labels[i + 1..] {
+            assert!(
+                !ra.shrink(0.5).intersects(rb.shrink(0.5)),
+                "{a:?} {ra:?} overlaps {b:?} {rb:?}"
+            );
+        }
+    }
+}
+
+/// The Ray panel's labels never overlap (the ray's "t =", the "hit" and, in object space,
+/// M^-1 d all end at the hit point), and its diagrams can be made big: in a window of
+/// their own, resizable, instead of ~160 points wide in the dock.
+#[test]
+fn the_ray_diagrams_can_be_big_and_their_labels_never_overlap() {
+    let mut h = harness((48, 48));
+    settle(&mut h);
+    h.state_mut()
+        .queue(AppCommand::OpenLecture(depth_t_index()));
+    settle(&mut h);
+    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    settle(&mut h);
+    h.state_mut().inspect(0, 28, 23);
+    for _ in 0..3 {
+        h.step();
+    }
+    let docked = h.get_by_label("World space diagram").rect();
+    let labels = diagram_labels(&h);
+    // Control: the labels are there to be compared (both diagrams' hits, t, normals).
+    assert!(labels.len() >= 8, "{labels:?}");
+    assert_apart(&labels);
+    h.get_by_label("Diagrams in a window").click();
+    for _ in 0..4 {
+        h.step();
+    }
+    let big = h.get_by_label("World space diagram").rect();
+    assert!(
+        big.width() >= 300.0 && big.height() >= 300.0,
+        "{big:?} (docked {docked:?})"
+    );
+    let labels = diagram_labels(&h);
+    assert!(labels.len() >= 8, "{labels:?}");
+    assert_apart(&labels);
+    // And back into the dock.
+    h.get_by_label("Dock the diagrams").click();
+    for _ in 0..3 {
+        h.step();
+    }
+    assert!(!h.state().ray_window);
+    let again = h.get_by_label("World space diagram").rect();
+    assert!(again.width() < 250.0, "docked again: {again:?}");
+}

@@ -58,6 +58,9 @@ pub enum AppCommand {
     ShowPixelInspector(bool),
     /// The Ray panel's diagrams beside the pixel inspector's story.
     ShowRayPanel(bool),
+    /// The Ray panel's diagrams in a window of their own (resizable, as big as wanted)
+    /// instead of the dock.
+    RayDiagramsInWindow(bool),
     /// Shadows, bounces, weight and the specular fix of the view (View › Rays).
     SetRays(tracelab_core::render::Secondary),
     ResetLayout,

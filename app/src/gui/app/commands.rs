@@ -104,6 +104,7 @@ impl TracelabApp {
             }
             AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
             AppCommand::ShowRayPanel(open) => self.ray_panel_open = open,
+            AppCommand::RayDiagramsInWindow(w) => self.ray_window = w,
             AppCommand::SetRays(rays) => self.view.secondary = rays,
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {

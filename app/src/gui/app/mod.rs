@@ -82,6 +82,8 @@ pub struct TracelabApp {
     pub pixel_inspector_open: bool,
     /// The Ray panel (world and object space diagrams) in the dock, beside the story.
     pub ray_panel_open: bool,
+    /// The Ray panel's diagrams in their own window instead of the dock.
+    pub ray_window: bool,
     /// File › Export animation's form, while open, and the export under way.
     pub animation: Option<AnimationForm>,
     pub animation_running: Option<animation_dialog::Running>,
@@ -142,6 +144,7 @@ impl TracelabApp {
             inspected: None,
             pixel_inspector_open: false,
             ray_panel_open: true,
+            ray_window: false,
             ray_orbits: [Orbit::default(); 2],
             lecture: None,
             pending_lecture: None,

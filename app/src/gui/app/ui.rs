@@ -291,11 +291,24 @@ impl TracelabApp {
                     if ui.checkbox(&mut ray, "Ray diagrams").changed() {
                         asked.push(AppCommand::ShowRayPanel(ray));
                     }
+                    if self.ray_panel_open {
+                        let (text, tip) = if self.ray_window {
+                            ("Dock the diagrams", "Back beside the story")
+                        } else {
+                            (
+                                "Diagrams in a window",
+                                "A window of their own: drag its corner to make them bigger",
+                            )
+                        };
+                        if ui.small_button(text).on_hover_text(tip).clicked() {
+                            asked.push(AppCommand::RayDiagramsInWindow(!self.ray_window));
+                        }
+                    }
                     if ui.small_button("Close").clicked() {
                         asked.push(AppCommand::ShowPixelInspector(false));
                     }
                 });
-                if self.ray_panel_open {
+                if self.ray_panel_open && !self.ray_window {
                     // The lecture's figure, docked beside the story: never over the image.
                     let width = ui.available_width();
                     egui::Panel::right(self.layout.panel_id("ray"))
@@ -316,6 +329,21 @@ impl TracelabApp {
                         }
                     });
             });
+        }
+        if self.pixel_inspector_open && self.ray_panel_open && self.ray_window {
+            let mut open = true;
+            egui::Window::new("Ray diagrams")
+                .id(egui::Id::unique(self.layout.panel_id("ray-window")))
+                .open(&mut open)
+                .resizable(true)
+                .default_size([760.0, 440.0])
+                .show(&ctx, |ui| {
+                    let story = self.story.as_ref().map(|(s, sc)| (s, sc.as_ref()));
+                    ray_panel::ui(ui, story, &mut self.ray_orbits);
+                });
+            if !open {
+                asked.push(AppCommand::ShowRayPanel(false));
+            }
         }
         let reserve = (bottom - ui.available_rect_before_wrap().bottom()).max(0.0);
         let mut pick = None;

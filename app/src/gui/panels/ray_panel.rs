@@ -51,15 +51,16 @@ fn line(painter: &egui::Painter, role: Role, pts: Vec<Pos2>) {
     }
 }
 
-/// The ray tree's colours, top left, for the roles the diagram holds.
-fn legend(painter: &egui::Painter, rect: egui::Rect, d: &Diagram) {
+/// The ray tree's colours, top left, for the roles the diagram holds; returns where it is.
+fn legend(painter: &egui::Painter, rect: egui::Rect, d: &Diagram) -> egui::Rect {
     let mut at = rect.left_top() + egui::vec2(8.0, 8.0);
+    let mut drawn = egui::Rect::NOTHING;
     let shown: Vec<(Role, &str)> = std::iter::once((Role::Ray, "eye ray"))
         .chain(Role::TREE)
         .filter(|(r, _)| d.find(*r).next().is_some())
         .collect();
     if shown.len() < 2 {
-        return;
+        return drawn;
     }
     for (role, name) in shown {
         line(
@@ -67,15 +68,19 @@ fn legend(painter: &egui::Painter, rect: egui::Rect, d: &Diagram) {
             role,
             vec![at + egui::vec2(0.0, 6.0), at + egui::vec2(22.0, 6.0)],
         );
-        painter.text(
+        let text = painter.text(
             at + egui::vec2(28.0, 0.0),
             egui::Align2::LEFT_TOP,
             name,
             egui::FontId::proportional(11.0),
             color(role),
         );
+        drawn = drawn
+            .union(text)
+            .union(egui::Rect::from_min_size(at, egui::vec2(22.0, 12.0)));
         at.y += 14.0;
     }
+    drawn
 }
 
 /// One diagram in `rect`; a drag on it turns `orbit`.
@@ -101,6 +106,7 @@ fn draw(
             }
         }
         let painter = ui.painter_at(rect);
+        let mut labels: Vec<(Pos2, &str, Color32)> = Vec::new();
         painter.rect_filled(rect, 4.0, Color32::from_gray(24));
         let (center, radius) = d.bounds();
         let half = rect.width().min(rect.height()) * 0.5 - 14.0;
@@ -140,22 +146,16 @@ fn draw(
                 }
             };
             if let Some(l) = &item.label {
-                painter.text(
-                    at + egui::vec2(4.0, -4.0),
-                    egui::Align2::LEFT_BOTTOM,
-                    l,
-                    egui::FontId::proportional(11.0),
-                    c,
-                );
+                labels.push((at, l.as_str(), c));
             }
         }
-        legend(&painter, rect, d);
+        let mut taken = vec![legend(&painter, rect, d)];
         // Say where the origin is when it lies outside the view.
         if let Some(o) = d.items.iter().find(|i| i.role == Role::Eye)
             && let Shape::Point(p) = o.shape
             && !rect.contains(proj(p))
         {
-            painter.text(
+            taken.push(painter.text(
                 rect.left_bottom() + egui::vec2(6.0, -6.0),
                 egui::Align2::LEFT_BOTTOM,
                 format!(
@@ -164,10 +164,128 @@ fn draw(
                 ),
                 egui::FontId::proportional(11.0),
                 color(Role::Eye),
+            ));
+        }
+        // Labels where they overlap nothing drawn before them (text, legend), each as a
+        // label widget, so the tests and screen readers find them.
+        let sizes: Vec<egui::Vec2> = labels
+            .iter()
+            .map(|(_, t, _)| {
+                painter
+                    .layout_no_wrap(t.to_string(), label_font(), Color32::WHITE)
+                    .size()
+            })
+            .collect();
+        let anchors: Vec<Pos2> = labels.iter().map(|(a, _, _)| *a).collect();
+        let placed = place_labels(&anchors, &sizes, rect.shrink(2.0), &taken);
+        for ((anchor, text, c), at) in labels.into_iter().zip(placed) {
+            if anchor.distance(anchor.clamp(at.min, at.max)) > 10.0 {
+                // Moved away from its point: a thin line says whose it is.
+                painter.line_segment(
+                    [anchor, anchor.clamp(at.min, at.max)],
+                    Stroke::new(0.5, c.gamma_multiply(0.6)),
+                );
+            }
+            ui.put(
+                at,
+                egui::Label::new(egui::RichText::new(text).font(label_font()).color(c))
+                    .selectable(false)
+                    .extend(),
             );
         }
-        response.on_hover_text(format!("{id}: drag to orbit, scroll to zoom"));
+        response
+            .accessible_name(format!("{title} diagram"))
+            .on_hover_text(format!("{id}: drag to orbit, scroll to zoom"));
     });
+}
+
+fn label_font() -> egui::FontId {
+    egui::FontId::proportional(11.0)
+}
+
+/// Where to put labels of `sizes` near their `anchors` inside `bounds`, overlapping neither
+/// each other nor `taken`: the first free spot on rings of growing distance around the
+/// anchor (right and above first, the old place); if none is free, the first free row of a
+/// list down the right edge; and last, the spot that overlaps least.
+pub fn place_labels(
+    anchors: &[Pos2],
+    sizes: &[egui::Vec2],
+    bounds: egui::Rect,
+    taken: &[egui::Rect],
+) -> Vec<egui::Rect> {
+    let mut placed: Vec<egui::Rect> = Vec::with_capacity(anchors.len());
+    let overlap = |r: &egui::Rect, placed: &[egui::Rect]| -> f32 {
+        placed
+            .iter()
+            .chain(taken)
+            .map(|o| {
+                let i = r.intersect(*o);
+                if i.is_positive() { i.area() } else { 0.0 }
+            })
+            .sum()
+    };
+    for (&a, &size) in anchors.iter().zip(sizes) {
+        let mut candidates = Vec::new();
+        for ring in [4.0f32, 14.0, 26.0, 40.0, 56.0] {
+            for (dx, dy) in [
+                (1.0, -1.0),
+                (1.0, 1.0),
+                (-1.0, -1.0),
+                (-1.0, 1.0),
+                (1.0, 0.0),
+                (-1.0, 0.0),
+                (0.0, -1.0),
+                (0.0, 1.0),
+            ] {
+                // The rectangle's corner (or edge middle) nearest the anchor sits `ring` away.
+                let min = egui::pos2(
+                    a.x + dx * ring
+                        - if dx < 0.0 {
+                            size.x
+                        } else if dx == 0.0 {
+                            size.x * 0.5
+                        } else {
+                            0.0
+                        },
+                    a.y + dy * ring
+                        - if dy < 0.0 {
+                            size.y
+                        } else if dy == 0.0 {
+                            size.y * 0.5
+                        } else {
+                            0.0
+                        },
+                );
+                candidates.push(egui::Rect::from_min_size(min, size));
+            }
+        }
+        // The list beside: rows down the right edge.
+        let mut y = bounds.top();
+        while y + size.y <= bounds.bottom() {
+            candidates.push(egui::Rect::from_min_size(
+                egui::pos2(bounds.right() - size.x, y),
+                size,
+            ));
+            y += size.y + 1.0;
+        }
+        let inside: Vec<egui::Rect> = candidates
+            .iter()
+            .copied()
+            .filter(|r| bounds.contains_rect(*r))
+            .collect();
+        let chosen = inside
+            .iter()
+            .find(|r| overlap(r, &placed) == 0.0)
+            .or_else(|| {
+                inside
+                    .iter()
+                    .min_by(|x, y| overlap(x, &placed).total_cmp(&overlap(y, &placed)))
+            })
+            .copied()
+            .unwrap_or(candidates[0]);
+        placed.push(chosen);
+    }
+    placed
 }
 
 /// Both diagrams side by side, or a line saying why there are none.
@@ -197,4 +315,36 @@ pub fn ui(ui: &mut egui::Ui, story: Option<(&RayStory, &Scene)>, orbits: &mut [O
             side,
         );
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_at_one_point_are_placed_apart_inside_the_diagram() {
+        let bounds = egui::Rect::from_min_size(Pos2::ZERO, egui::vec2(200.0, 150.0));
+        let legend = egui::Rect::from_min_size(Pos2::new(0.0, 0.0), egui::vec2(80.0, 40.0));
+        // The ray's t, the hit and M^-1 d all end at the hit point.
+        let anchors = [Pos2::new(60.0, 30.0); 3];
+        let sizes = [
+            egui::vec2(50.0, 13.0),
+            egui::vec2(20.0, 13.0),
+            egui::vec2(90.0, 13.0),
+        ];
+        let placed = place_labels(&anchors, &sizes, bounds, &[legend]);
+        for (i, a) in placed.iter().enumerate() {
+            assert!(bounds.contains_rect(*a), "{a:?}");
+            assert!(!a.intersects(legend), "{a:?}");
+            for b in &placed[i + 1..] {
+                assert!(!a.intersects(*b), "{a:?} {b:?}");
+            }
+            // Near its point, not thrown across the diagram.
+            assert!(a.distance_to_pos(anchors[0]) < 60.0, "{a:?}");
+        }
+        // Control: where they used to go (right of and above the point), they overlap.
+        let old =
+            |s: egui::Vec2| egui::Rect::from_min_size(anchors[0] + egui::vec2(4.0, -4.0 - s.y), s);
+        assert!(old(sizes[0]).intersects(old(sizes[1])));
+    }
 }
