@@ -422,3 +422,67 @@ fn the_view_bar_is_two_rows_at_1280_wide_with_labels_before_their_controls() {
         "the row count counts rows"
     );
 }
+
+/// A sphere so big that it fills the bottom third of the image, edge to edge.
+const FLOOR: &str = "
+OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 }
+Lights { numLights 1 DirectionalLight { direction -0.3 -0.5 -1 color 1 1 1 } }
+Background { color 0.2 0 0.6 ambientLight 0.1 0.1 0.1 }
+Materials { numMaterials 1 Material { diffuseColor 1 0.8 0.3 } }
+Group { numObjects 1 MaterialIndex 0 Sphere { center 0 -10 0 radius 9.4 } }
+";
+
+/// The badges (axes triad, light directions) drawn over a pixel that shows the object.
+fn badges_over_the_object(h: &Harness<'static, TracelabApp>) -> Vec<egui::Rect> {
+    let app = h.state();
+    let shown = app.shown();
+    app.overlay_badges()
+        .into_iter()
+        .filter(|b| {
+            let s = shown
+                .iter()
+                .find(|s| s.rect.contains(b.center()))
+                .expect("a badge over an image");
+            let [w, hh] = s.size();
+            let px =
+                |p: egui::Pos2| (p - s.rect.min) / s.rect.size() * egui::vec2(w as f32, hh as f32);
+            let (a, z) = (px(b.min), px(b.max));
+            app.worker.with_published(|p| {
+                let f = p.expect("published").frames[0].lock();
+                (a.y.max(0.0) as u32..(z.y.ceil() as u32).min(hh as u32)).any(|row| {
+                    (a.x.max(0.0) as u32..(z.x.ceil() as u32).min(w as u32))
+                        .any(|x| f.get(x, row).is_some_and(|s| s.t.is_finite()))
+                })
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn the_triad_and_light_badges_keep_off_the_object_and_leave_small_views() {
+    let scene = scene_file("badges", FLOOR);
+    let mut h = harness(&scene, (48, 48));
+    settle(&mut h);
+    for tab in ["Colour", "All three"] {
+        click(&mut h, tab);
+        let badges = h.state().overlay_badges();
+        // Control: drawn (a triad and a light per image), so "none over the object" says something.
+        let images = h.state().shown().len();
+        assert_eq!(badges.len(), 2 * images, "{tab}: {badges:?}");
+        assert_eq!(badges_over_the_object(&h), [], "{tab}");
+    }
+    // "All three" in the smallest window: images under 120 points, no badges at all.
+    h.set_size(egui::vec2(960.0, 600.0));
+    for _ in 0..3 {
+        h.step();
+    }
+    settle(&mut h);
+    let small = h.state().shown();
+    assert!(
+        small
+            .iter()
+            .all(|s| s.rect.width().min(s.rect.height()) < 120.0),
+        "{small:?}"
+    );
+    assert_eq!(h.state().overlay_badges(), []);
+}

@@ -1,6 +1,8 @@
 //! What the render view draws over the image besides the gizmo: the selected object's
 //! outline (from the per-pixel object ids that picking uses), a world-axes triad, the
-//! directional lights' directions and a marker at each point light.
+//! directional lights' directions and a marker at each point light. The triad and the
+//! light directions are badges sized to the image and put in corners that show no object
+//! (`place_badges`), so in small views they keep off what the user looks at.
 
 use glam::Vec3;
 use tracelab_core::{Frame, NodeId, Scene};
@@ -66,10 +68,118 @@ fn on_screen(basis: &ViewBasis, d: Vec3) -> egui::Vec2 {
     egui::vec2(d.dot(basis.rays.horizontal), -d.dot(basis.rays.up))
 }
 
-/// The world axes in the image's lower-left corner.
-pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
-    let o = rect.left_bottom() + egui::vec2(34.0, -34.0);
-    painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
+/// Below this many points on its shorter side, an image gets no badges (triad, light
+/// directions): in "All three" and lecture figures they covered the object.
+pub const MIN_BADGE_VIEW: f32 = 120.0;
+/// The badges' largest radius, in views of 370 points and more.
+const BADGE_RADIUS: f32 = 26.0;
+
+/// A corner of the image, for a badge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Corner {
+    BottomLeft,
+    TopLeft,
+    TopRight,
+    BottomRight,
+}
+
+/// Where the badges go in an image drawn in `rect`: the triad's centre and the directional
+/// lights' centres (one per light, a row), all of radius `radius`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Badges {
+    pub radius: f32,
+    pub triad: Option<egui::Pos2>,
+    pub lights: Vec<egui::Pos2>,
+}
+
+impl Badges {
+    /// Every badge's square on screen.
+    pub fn rects(&self) -> Vec<egui::Rect> {
+        let side = egui::Vec2::splat(self.radius * 2.0);
+        self.triad
+            .iter()
+            .chain(&self.lights)
+            .map(|c| egui::Rect::from_center_size(*c, side))
+            .collect()
+    }
+}
+
+/// The badges for an image in `rect` with `lights` directional lights: scaled to the image
+/// (none below [`MIN_BADGE_VIEW`]), each in the first corner where `shows_object` says no
+/// object is under it (the triad prefers the bottom left, the lights the top right), else,
+/// in a view big enough to spare the room, its own corner; in a small one, none.
+pub fn place_badges(
+    rect: egui::Rect,
+    lights: usize,
+    shows_object: &dyn Fn(egui::Rect) -> bool,
+) -> Badges {
+    let side = rect.width().min(rect.height());
+    let none = Badges {
+        radius: 0.0,
+        triad: None,
+        lights: Vec::new(),
+    };
+    if side < MIN_BADGE_VIEW {
+        return none;
+    }
+    let r = (side * 0.07).clamp(10.0, BADGE_RADIUS);
+    let margin = 4.0;
+    let step = 2.0 * r + margin;
+    // A row of `n` badges starting at `corner`, going inward along the edge.
+    let row = |corner: Corner, n: usize| -> Vec<egui::Pos2> {
+        let (start, dir) = match corner {
+            Corner::BottomLeft => (
+                rect.left_bottom() + egui::vec2(r + margin, -r - margin),
+                1.0,
+            ),
+            Corner::TopLeft => (rect.left_top() + egui::vec2(r + margin, r + margin), 1.0),
+            Corner::TopRight => (rect.right_top() + egui::vec2(-r - margin, r + margin), -1.0),
+            Corner::BottomRight => (
+                rect.right_bottom() + egui::vec2(-r - margin, -r - margin),
+                -1.0,
+            ),
+        };
+        (0..n)
+            .map(|i| start + egui::vec2(dir * step * i as f32, 0.0))
+            .collect()
+    };
+    let square = |c: egui::Pos2| egui::Rect::from_center_size(c, egui::Vec2::splat(2.0 * r));
+    let fits = |centres: &[egui::Pos2], taken: &[egui::Rect]| {
+        centres.iter().all(|c| {
+            let sq = square(*c);
+            rect.contains_rect(sq) && !taken.iter().any(|t| t.intersects(sq)) && !shows_object(sq)
+        })
+    };
+    let big = side >= 3.0 * MIN_BADGE_VIEW;
+    use Corner::*;
+    let triad_row = [BottomLeft, TopLeft, BottomRight, TopRight]
+        .into_iter()
+        .map(|c| row(c, 1))
+        .find(|r| fits(r, &[]))
+        .or_else(|| big.then(|| row(BottomLeft, 1)));
+    let taken: Vec<egui::Rect> = triad_row.iter().flatten().map(|c| square(*c)).collect();
+    let light_row = if lights == 0 {
+        None
+    } else {
+        [TopRight, TopLeft, BottomRight, BottomLeft]
+            .into_iter()
+            .map(|c| row(c, lights))
+            .find(|r| fits(r, &taken))
+            .or_else(|| {
+                let r = row(TopRight, lights);
+                (big && r.iter().all(|c| rect.contains_rect(square(*c)))).then_some(r)
+            })
+    };
+    Badges {
+        radius: r,
+        triad: triad_row.and_then(|r| r.first().copied()),
+        lights: light_row.unwrap_or_default(),
+    }
+}
+
+/// The world axes in a badge of radius `r` centred at `o`.
+pub fn triad(painter: &egui::Painter, basis: &ViewBasis, o: egui::Pos2, r: f32) {
+    painter.circle_filled(o, r, egui::Color32::from_black_alpha(90));
     let axes = [
         (Vec3::X, "x", egui::Color32::from_rgb(230, 70, 70)),
         (Vec3::Y, "y", egui::Color32::from_rgb(90, 210, 90)),
@@ -81,45 +191,48 @@ pub fn triad(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect) {
         b.0.dot(basis.rays.direction)
             .total_cmp(&a.0.dot(basis.rays.direction))
     });
+    let len = r * 0.77;
     for (d, name, c) in order {
-        let v = on_screen(basis, *d) * 20.0;
+        let v = on_screen(basis, *d) * len;
         painter.line_segment([o, o + v], egui::Stroke::new(2.0, *c));
         painter.text(
             o + v * 1.2,
             egui::Align2::CENTER_CENTER,
             *name,
-            egui::FontId::monospace(11.0),
+            egui::FontId::monospace((r * 0.42).clamp(8.0, 11.0)),
             *c,
         );
     }
 }
 
-/// Each directional light's direction (from the light into the scene) in the image's upper
-/// right corner, in the light's colour.
-pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scene: &Scene) {
-    for (i, l) in scene.lights().iter().enumerate() {
+/// Each directional light's direction (from the light into the scene), in the light's
+/// colour, in the badges at `centres` (one per directional light, in order).
+pub fn lights(
+    painter: &egui::Painter,
+    basis: &ViewBasis,
+    centres: &[egui::Pos2],
+    r: f32,
+    scene: &Scene,
+) {
+    let directional = scene
+        .lights()
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| Some((i, l, l.direction().and_then(tracelab_core::scene::unit)?)));
+    for ((i, l, d), &o) in directional.zip(centres) {
         // A point light has no one direction (its place is for the gizmo to show).
-        let Some(d) = l.direction().and_then(tracelab_core::scene::unit) else {
-            continue;
-        };
         let colour = light_colour(l.color);
-        let o = rect.right_top() + egui::vec2(-34.0 - 60.0 * i as f32, 34.0);
-        painter.circle_filled(o, 26.0, egui::Color32::from_black_alpha(90));
-        let v = on_screen(basis, d) * 20.0;
+        painter.circle_filled(o, r, egui::Color32::from_black_alpha(90));
+        let v = on_screen(basis, d) * (r * 0.77);
         // Into the screen: a cross; out of it: a dot (the light is behind the viewer).
-        if v.length() < 4.0 {
+        if v.length() < r * 0.15 {
             // Drawn, not typed: the UI's fonts have no ⊗ or ⊙.
             let stroke = egui::Stroke::new(2.0, colour);
-            painter.circle_stroke(o, 7.0, stroke);
+            let k = r * 0.27;
+            painter.circle_stroke(o, k * 1.4, stroke);
             if d.dot(basis.rays.direction) > 0.0 {
-                painter.line_segment(
-                    [o + egui::vec2(-5.0, -5.0), o + egui::vec2(5.0, 5.0)],
-                    stroke,
-                );
-                painter.line_segment(
-                    [o + egui::vec2(-5.0, 5.0), o + egui::vec2(5.0, -5.0)],
-                    stroke,
-                );
+                painter.line_segment([o + egui::vec2(-k, -k), o + egui::vec2(k, k)], stroke);
+                painter.line_segment([o + egui::vec2(-k, k), o + egui::vec2(k, -k)], stroke);
             } else {
                 painter.circle_filled(o, 2.5, colour);
             }
@@ -127,13 +240,22 @@ pub fn lights(painter: &egui::Painter, basis: &ViewBasis, rect: egui::Rect, scen
             painter.arrow(o - v * 0.5, v, egui::Stroke::new(2.0, colour));
         }
         painter.text(
-            o + egui::vec2(0.0, 18.0),
+            o + egui::vec2(0.0, r * 0.7),
             egui::Align2::CENTER_TOP,
             format!("light {i}"),
-            egui::FontId::proportional(10.0),
+            egui::FontId::proportional((r * 0.38).clamp(8.0, 10.0)),
             colour,
         );
     }
+}
+
+/// How many lights [`lights`] draws: the directional ones.
+pub fn directional_lights(scene: &Scene) -> usize {
+    scene
+        .lights()
+        .iter()
+        .filter(|l| l.direction().and_then(tracelab_core::scene::unit).is_some())
+        .count()
 }
 
 /// A small sun at each point light's position, in its colour, named; the selected one

@@ -45,6 +45,11 @@ impl TracelabApp {
         self.viewport.shown()
     }
 
+    /// Where the view drew the axes triad and the light badges in the last frame.
+    pub fn overlay_badges(&self) -> Vec<egui::Rect> {
+        self.viewport.badges().to_vec()
+    }
+
     /// Starts (or keeps) the render for the current document and view.
     pub fn request_render(&mut self, size: (u32, u32)) {
         let settings = Viewport::settings(&self.view, size);

@@ -78,6 +78,8 @@ pub struct Viewport {
     textures: ViewTextures,
     /// What the last frame drew: each texture, where, and which part of it.
     drawn: Vec<Drawn>,
+    /// Where the last frame drew the triad and light badges.
+    badges: Vec<egui::Rect>,
     /// The pixel being inspected, marked in every image.
     pub marker: Option<(u32, u32)>,
     /// Orbit, pan, zoom and the gizmo's drags.
@@ -130,6 +132,7 @@ impl Viewport {
         let ctx = ui.ctx().clone();
         let mut pick = None;
         self.drawn.clear();
+        self.badges.clear();
         self.tools.begin_frame();
         worker.with_published(|p| {
             let Some(p) = p else {
@@ -237,8 +240,23 @@ impl Viewport {
                     if let Some(o) = self.textures.outline() {
                         painter.image(o.id(), rect, uv, egui::Color32::WHITE);
                     }
-                    overlays::triad(&painter, &view.basis, rect);
-                    overlays::lights(&painter, &view.basis, rect, &doc.scene);
+                    let shows_object = |r: egui::Rect| shows_object(worker, frame, rect, r);
+                    let badges = overlays::place_badges(
+                        rect.intersect(cell),
+                        overlays::directional_lights(&doc.scene),
+                        &shows_object,
+                    );
+                    if let Some(o) = badges.triad {
+                        overlays::triad(&painter, &view.basis, o, badges.radius);
+                    }
+                    overlays::lights(
+                        &painter,
+                        &view.basis,
+                        &badges.lights,
+                        badges.radius,
+                        &doc.scene,
+                    );
+                    self.badges.extend(badges.rects());
                     if let Some(g) = ViewTools::gizmo(doc, &view, s.gizmo_axes) {
                         g.paint(&painter, &view, self.tools.hot);
                     }
@@ -302,6 +320,11 @@ impl Viewport {
             .collect()
     }
 
+    /// Where the last frame drew the axes triad and the light badges.
+    pub fn badges(&self) -> &[egui::Rect] {
+        &self.badges
+    }
+
     /// The settings the worker should render with.
     pub fn settings(s: &ViewSettings, size: (u32, u32)) -> RenderSettings {
         RenderSettings {
@@ -314,6 +337,26 @@ impl Viewport {
             secondary: s.secondary,
         }
     }
+}
+
+/// Whether the part `r` (screen points) of an image drawn in `image` shows an object in the
+/// render of frame `frame` on screen (any pixel there a hit).
+fn shows_object(worker: &RenderWorker, frame: usize, image: egui::Rect, r: egui::Rect) -> bool {
+    worker.with_published(|p| {
+        let Some(f) = p.and_then(|p| p.frames.get(frame)) else {
+            return false;
+        };
+        let f = f.lock();
+        let (w, h) = (f.width as f32, f.height as f32);
+        let to_px = |q: egui::Pos2| ((q - image.min) / image.size()) * egui::vec2(w, h);
+        let (a, b) = (to_px(r.min), to_px(r.max));
+        let xs = (a.x.floor().max(0.0) as u32)..(b.x.ceil().min(w) as u32);
+        let rows = (a.y.floor().max(0.0) as u32)..(b.y.ceil().min(h) as u32);
+        rows.into_iter().any(|row| {
+            xs.clone()
+                .any(|x| f.get(x, row).is_some_and(|s| s.t.is_finite()))
+        })
+    })
 }
 
 /// `rect` cut by the split line at `at` (0..1 from the left or the top): the part before the
