@@ -179,6 +179,21 @@ impl RenderWorker {
         })
     }
 
+    /// Waits up to `budget` for the newest request's last pass (polling every millisecond);
+    /// true when it is done.
+    pub fn wait_for_full(&self, budget: Duration) -> bool {
+        let start = Instant::now();
+        loop {
+            let done = self.with_published(|p| {
+                p.is_some_and(|p| p.job.request == self.requests && p.full.is_some())
+            });
+            if done || start.elapsed() >= budget {
+                return done;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
     pub fn last_generation(&self) -> u64 {
         self.last_generation
     }

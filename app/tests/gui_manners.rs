@@ -592,3 +592,38 @@ fn selecting_a_material_does_not_widen_the_inspector() {
     assert_eq!(edge(&h), before, "the inspector's edge moved");
     assert_eq!(picture(&h), view);
 }
+
+/// Latency: the frame that applies a typed value shows the picture rendered with it (a
+/// small scene renders in milliseconds, so the frame waits for it and lays itself out
+/// again) instead of painting the old picture once more and the new one a frame later.
+#[test]
+fn the_frame_that_applies_a_typed_value_shows_its_picture() {
+    let (mut h, id) = first_transform("latency");
+    settle(&mut h);
+    let before = h.state().shown()[0].rgb8();
+    focus_and_type(&mut h, "Translate x", "-0.5");
+    assert!(
+        h.state().shown()[0].rgb8() == before,
+        "nothing applied while typing"
+    );
+    // Enter pressed and released within one frame (kittest's key_press takes two).
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::Key {
+            key: egui::Key::Enter,
+            physical_key: None,
+            pressed,
+            repeat: false,
+            modifiers: Modifiers::NONE,
+        });
+    }
+    h.step();
+    assert_eq!(translate_x(h.state(), id), -0.5, "Enter applies");
+    let shown = h.state().shown()[0].rgb8();
+    assert!(
+        shown != before,
+        "the frame that applied the value still shows the old picture"
+    );
+    // And it is the finished picture: nothing changes once the worker is idle.
+    settle(&mut h);
+    assert!(h.state().shown()[0].rgb8() == shown);
+}

@@ -130,6 +130,8 @@ pub struct TracelabApp {
     pub note: Option<(String, Instant)>,
     /// The size the view renders at, for framing.
     render_size: (u32, u32),
+    /// When the last frame's UI code ended (the edit → screen timing log).
+    last_frame_end: Option<Instant>,
 }
 
 impl TracelabApp {
@@ -172,6 +174,7 @@ impl TracelabApp {
             commands: Vec::new(),
             note: None,
             render_size: (1, 1),
+            last_frame_end: None,
         };
         if let Some(cc) = cc {
             let ctx = cc.egui_ctx.clone();

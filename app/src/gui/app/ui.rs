@@ -50,8 +50,9 @@ impl TracelabApp {
         self.viewport.badges().to_vec()
     }
 
-    /// Starts (or keeps) the render for the current document and view.
-    pub fn request_render(&mut self, size: (u32, u32)) {
+    /// Starts (or keeps) the render for the current document and view; true when a new
+    /// render was started.
+    pub fn request_render(&mut self, size: (u32, u32)) -> bool {
         let settings = Viewport::settings(&self.view, size);
         // While the view is being dragged, coarse passes only; the full image once it stops.
         self.worker.coarse_only = self.viewport.tools.moving();
@@ -61,7 +62,7 @@ impl TracelabApp {
             || Arc::new(scene.clone()),
             settings,
             self.view.modes(),
-        );
+        )
     }
 
     pub(super) fn menu(&mut self, ui: &mut egui::Ui) {
@@ -170,8 +171,35 @@ impl TracelabApp {
     /// One frame of UI, shared by eframe and tests.
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let t0 = Instant::now();
+        // The edit → screen timings (`TRACELAB_LOG_TIMES`): the frame after the one that
+        // uploaded a finished image starts once that one is painted and presented.
+        if let Some(u) = self.viewport.take_uploaded_full() {
+            let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            log::info!(
+                target: crate::logging::TIMES,
+                "generation {}: on screen {:.1} ms after the edit's render was submitted: render {:.1} ms, wait for a frame {:.1} ms, upload {:.1} ms, rest of that frame's UI code {:.1} ms, paint and present {:.1} ms",
+                u.generation,
+                ms(t0 - u.submitted),
+                ms(u.full),
+                ms(u.upload_started.saturating_duration_since(u.submitted + u.full)),
+                ms(u.uploaded - u.upload_started),
+                ms(self.last_frame_end.map_or(Duration::ZERO, |e| e.saturating_duration_since(u.uploaded))),
+                ms(self.last_frame_end.map_or(Duration::ZERO, |e| t0.saturating_duration_since(e))),
+            );
+        }
+        let generation = self.doc.generation;
         self.frame_inner(ui);
-        log::info!(target: crate::logging::FRAMES, "ui code {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
+        let end = Instant::now();
+        if self.doc.generation != generation {
+            log::info!(
+                target: crate::logging::TIMES,
+                "generation {}: edit applied and its render submitted by a frame whose UI code took {:.1} ms",
+                self.doc.generation,
+                ms_since(t0, end)
+            );
+        }
+        self.last_frame_end = Some(end);
+        log::info!(target: crate::logging::FRAMES, "ui code {:.1} ms", ms_since(t0, end));
     }
 
     pub(super) fn frame_inner(&mut self, ui: &mut egui::Ui) {
@@ -353,6 +381,7 @@ impl TracelabApp {
         let reserve = (bottom - ui.available_rect_before_wrap().bottom()).max(0.0);
         let mut pick = None;
         let mut size = (1, 1);
+        let mut started = false;
         let view = egui::CentralPanel::default().show(ui, |ui| {
             if let Some(f) = self.lecture.and_then(|i| lecture::FIGURES.get(i)) {
                 ui.horizontal(|ui| {
@@ -374,7 +403,7 @@ impl TracelabApp {
             let area = ui.available_size() + egui::vec2(0.0, reserve);
             size = Viewport::render_size(&self.view, area, ui.pixels_per_point());
             self.render_size = size;
-            self.request_render(size);
+            started |= self.request_render(size);
             pick = self.viewport.images(
                 ui,
                 &mut self.view,
@@ -404,7 +433,20 @@ impl TracelabApp {
         self.run_commands(&ctx);
         // Edits and dialogs above changed the document after the view asked for its render:
         // start the new one now, not on the next input event.
-        self.request_render(size);
+        started |= self.request_render(size);
+        // A typed value, a click or a key changed what the view shows. A small scene renders
+        // in a few milliseconds, and painting a frame costs more (tens of milliseconds on a
+        // software rasteriser): rather than paint this frame with the old picture and the
+        // next with the new one, wait a little for the render and lay this frame out again
+        // with it (egui discards this pass and runs another before painting). Not while a
+        // pointer drags or the wheel turns: those frames keep the coarse passes flowing.
+        let gesture = ctx.input(|i| i.pointer.any_down())
+            || self.viewport.tools.dragging()
+            || self.viewport.tools.wheel_busy();
+        if started && !gesture && !ctx.will_discard() {
+            self.worker.wait_for_full(SAME_FRAME_BUDGET);
+            ctx.request_discard("the edit's picture is ready: show it in this frame");
+        }
         if self.viewport.tools.dragging() || self.viewport.tools.wheel_busy() {
             // Notice when the pointer stops, to refine.
             ctx.request_repaint_after(view_tools::STILL_AFTER / 2);
@@ -416,6 +458,10 @@ impl TracelabApp {
         }
     }
 }
+
+/// How long a frame that changed the picture waits for the render to finish, so that it is
+/// painted with the new picture instead of the old one (see `frame_inner`).
+const SAME_FRAME_BUDGET: Duration = Duration::from_millis(25);
 
 /// The course's `-shadows`, `-bounces` and `-weight`, and assignment 3's optional fix: off,
 /// 0 and 0 as the course's `raytracer` starts. The coarse passes trace what the full pass
@@ -430,4 +476,8 @@ fn rays_menu(ui: &mut egui::Ui, s: &mut tracelab_core::render::Secondary) {
     );
     ui.checkbox(&mut s.specular_fix, "Specular fix (optional, assignment 3)")
         .on_hover_text("The highlight fades with max(N·L, 0) instead of stopping where N·L ≤ 0");
+}
+
+fn ms_since(a: Instant, b: Instant) -> f64 {
+    b.saturating_duration_since(a).as_secs_f64() * 1e3
 }

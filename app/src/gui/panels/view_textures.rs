@@ -31,6 +31,23 @@ pub struct ViewTextures {
     /// generation).
     outline: Option<egui::TextureHandle>,
     outline_key: Option<(u64, u64, Option<Selection>, u64)>,
+    /// Timing log: the render request whose finished image was logged as uploaded.
+    full_logged: u64,
+    /// Timing log: a finished image uploaded this frame, to be reported as painted by the
+    /// next frame.
+    pub uploaded_full: Option<UploadedFull>,
+}
+
+/// When a finished image went to the GPU (the edit → screen timing log).
+#[derive(Clone, Copy, Debug)]
+pub struct UploadedFull {
+    pub generation: u64,
+    /// When the UI asked for the render (right after applying the edit).
+    pub submitted: std::time::Instant,
+    /// From the submit to the render's last pass.
+    pub full: std::time::Duration,
+    pub upload_started: std::time::Instant,
+    pub uploaded: std::time::Instant,
 }
 
 /// The texture slot of a frame's view.
@@ -98,6 +115,8 @@ impl ViewTextures {
         if p.passes_done == 0 {
             return;
         }
+        let started = std::time::Instant::now();
+        let mut any = false;
         let mut need: Vec<(usize, View)> = s.cells().iter().map(|&(f, v, _)| (f, v)).collect();
         if s.compare == Compare::Split {
             need.extend(s.cells().iter().map(|&(_, v, _)| (1, v)));
@@ -141,6 +160,21 @@ impl ViewTextures {
             }
             self.uploaded[i] = key;
             self.shown_size = (w, h);
+            any = true;
+        }
+        let timing = log::log_enabled!(target: crate::logging::TIMES, log::Level::Info);
+        if timing && any && p.full.is_some() && self.full_logged != p.job.request {
+            // The finished image went to the GPU in this frame; the next frame reports when
+            // it was painted, so ask for it at once.
+            self.full_logged = p.job.request;
+            self.uploaded_full = Some(UploadedFull {
+                generation: p.job.generation,
+                submitted: p.job.submitted,
+                full: p.full.unwrap_or_default(),
+                upload_started: started,
+                uploaded: std::time::Instant::now(),
+            });
+            ctx.request_repaint();
         }
         if p.job.generation != self.shown_generation {
             self.shown_generation = p.job.generation;

@@ -87,6 +87,11 @@ pub struct Viewport {
 }
 
 impl Viewport {
+    /// Timing log: a finished image uploaded last frame, taken once.
+    pub fn take_uploaded_full(&mut self) -> Option<view_textures::UploadedFull> {
+        self.textures.uploaded_full.take()
+    }
+
     /// Size of the image shown, in pixels.
     pub fn shown_size(&self) -> (u32, u32) {
         self.textures.shown_size
