@@ -130,7 +130,7 @@ pub static FIGURES: &[Figure] = &[
             "Incorrect vs correct normal transformation",
             [
                 "Above the yellow line (M^-1)^T·n, below it M·n: below, the shading slides off the sheared shapes.",
-                "Click a pixel: the Ray panel draws both normals; the toolbar gives their largest angle.",
+                "Click a pixel: the Ray panel draws both normals; the view bar gives their largest angle.",
             ],
         )
     },
