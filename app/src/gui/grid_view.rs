@@ -9,7 +9,7 @@ use tracelab_core::accel::CellVisit;
 use tracelab_core::geometry::Aabb;
 
 use crate::gui::panels::pixel_inspector::Inspected;
-use crate::gui::ray_diagram::{Item, Role, Shape};
+use crate::gui::ray_diagram::{Diagram, Item, Role, Shape};
 use crate::render_worker::{GridRequest, Published};
 
 /// The most cells a side may have in the editor: 256³ is the core's cell cap
@@ -91,6 +91,10 @@ pub struct GridPick {
     /// The cells the eye ray walks, nearest first, up to the one holding its hit.
     pub walk: Vec<CellVisit>,
     pub hit: bool,
+    /// The eye ray's origin, and where the walk leaves off (the hit, or where the ray
+    /// leaves the grid): the world diagram's ray when the ray hits nothing.
+    pub origin: Vec3,
+    pub end: Vec3,
     /// The world diagram's additions: occupied cells, then the walked ones.
     pub items: Vec<Item>,
 }
@@ -113,11 +117,12 @@ impl GridPick {
         } else {
             String::new()
         };
+        let n = self.walk.len();
         format!(
-            "Grid {x}×{y}×{z}: {} occupied cells (grey){drawn}. The ray walks {} cells (orange, \
-             numbered) {}: {}",
+            "Grid {x}×{y}×{z}: {} occupied cells (grey){drawn}. The ray walks {n} cell{} \
+             (orange, numbered) {}: {}",
             self.occupied,
-            self.walk.len(),
+            if n == 1 { "" } else { "s" },
             if self.hit {
                 "to its hit"
             } else {
@@ -125,6 +130,26 @@ impl GridPick {
             },
             cells.join(" ")
         )
+    }
+}
+
+impl GridPick {
+    /// The world diagram for a ray that hits nothing: the grid, the walk and the ray alone.
+    pub fn miss_diagram(&self) -> Diagram {
+        let mut items = vec![
+            Item {
+                role: Role::Eye,
+                shape: Shape::Point(self.origin),
+                label: Some("eye".into()),
+            },
+            Item {
+                role: Role::Ray,
+                shape: Shape::Line(vec![self.origin, self.end]),
+                label: Some("misses".into()),
+            },
+        ];
+        items.extend(self.items.iter().cloned());
+        Diagram { items }
     }
 }
 
@@ -157,7 +182,14 @@ pub fn pick(p: &Published, at: &Inspected) -> Option<GridPick> {
             label,
         });
     }
+    let end = match (walk.hit, walk.cells.last()) {
+        (Some(h), _) => ray.at(h.t),
+        (None, Some(v)) => ray.at(v.t_exit),
+        (None, None) => ray.at(c.camera.t_min()),
+    };
     Some(GridPick {
+        origin: ray.origin,
+        end,
         cells: g.cells,
         occupied: occupied.len(),
         drawn,

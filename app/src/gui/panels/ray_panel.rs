@@ -28,7 +28,7 @@ fn color(role: Role) -> Color32 {
         Role::Refracted => Color32::from_rgb(200, 120, 255),
         Role::Shadow => Color32::from_rgb(170, 170, 140),
         Role::ShadowBlocked => Color32::from_rgb(255, 70, 70),
-        Role::GridCell => Color32::from_rgba_unmultiplied(120, 130, 150, 110),
+        Role::GridCell => Color32::from_rgba_unmultiplied(120, 130, 150, 45),
         Role::GridWalk => Color32::from_rgb(255, 150, 40),
     }
 }
@@ -186,6 +186,21 @@ pub fn ui(
         return;
     };
     let Some((mut world, object)) = diagrams(scene, story) else {
+        if let Some(g) = grid {
+            // No hit, but a walk through the grid to draw.
+            ui.label(egui::RichText::new(g.summary()).small());
+            let avail = ui.available_size();
+            let side = egui::vec2(avail.x.max(120.0), (avail.y - 24.0).max(120.0));
+            draw(
+                ui,
+                "world",
+                "World space",
+                &g.miss_diagram(),
+                &mut orbits[0],
+                side,
+            );
+            return;
+        }
         ui.label("The ray misses every object: nothing to draw.");
         return;
     };
