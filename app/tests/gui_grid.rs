@@ -138,7 +138,7 @@ fn the_grid_menu_renders_through_the_grid_and_shows_the_visualize_grid_picture()
 
 /// Eight triangles each spanning the whole scene box: in 256³ cells they would be listed
 /// 134 million times, past the core's cap (`MAX_ENTRIES`), so the grid is refused.
-fn big_triangles() -> PathBuf {
+fn big_triangles(tag: &str) -> PathBuf {
     let mut tris = String::new();
     for k in 0..8 {
         let s = if k % 2 == 0 { 1 } else { -1 };
@@ -152,14 +152,15 @@ fn big_triangles() -> PathBuf {
          Materials {{ numMaterials 1 Material {{ diffuseColor 1 0 0 }} }}\n\
          Group {{ numObjects 8 MaterialIndex 0 {tris} }}\n"
     );
-    let p = common::temp_dir("grid", "refused").join("big_triangles.txt");
+    // A folder per test: temp_dir empties it, and tests run side by side.
+    let p = common::temp_dir("grid", tag).join("big_triangles.txt");
     std::fs::write(&p, text).expect("write scene");
     p
 }
 
 #[test]
 fn a_grid_the_core_refuses_is_said_and_the_view_renders_through_the_bvh() {
-    let path = big_triangles();
+    let path = big_triangles("refused");
     let mut h = harness_on(path.clone());
     let before = shown(&h);
     let set = |h: &mut Harness<'static, TracelabApp>, n: u32| {
@@ -338,4 +339,49 @@ fn the_ray_panel_lists_and_draws_the_cells_the_picked_ray_walks() {
     let label = h.get_by_label_contains(&text);
     let shown = format!("{label:?}");
     assert!(shown.contains(&list.join(" ")), "{shown}");
+}
+
+#[test]
+fn a_ray_that_walks_the_grid_and_hits_nothing_still_has_its_walk_drawn() {
+    let path = big_triangles("miss");
+    let mut h = harness_on(path.clone());
+    h.state_mut()
+        .queue(tracelab::gui::command::AppCommand::SetGrid(GridSettings {
+            on: true,
+            cells: [6, 6, 6],
+            visualize: false,
+        }));
+    settle(&mut h);
+    // A pixel whose ray crosses the grid's box between the triangles, by the library.
+    let lib = library_of(&path, Some(UVec3::splat(6)));
+    let t_min = lib.camera.t_min();
+    let (x, row, cells) = (0..SIZE.1)
+        .flat_map(|r| (0..SIZE.0).map(move |x| (x, r)))
+        .find_map(|(x, r)| {
+            let ray = lib.camera.pixel_ray(x, r, SIZE.0, SIZE.1);
+            let w = lib.grid_walk(&ray, t_min, f32::INFINITY)?;
+            (w.hit.is_none() && w.cells.len() >= 2).then_some((x, r, w.cells))
+        })
+        .expect("a ray through the grid that misses every triangle");
+    h.state_mut().inspect(0, x, row);
+    h.state_mut().ray_panel_open = true;
+    settle(&mut h);
+    let story = h.state().story.as_ref().map(|(s, _)| s.hit.is_some());
+    assert_eq!(
+        story,
+        Some(false),
+        "pixel ({x}, {row}): {:?}",
+        h.state().grid_pick
+    );
+    let pick = h.state().grid_pick.clone().expect("a walk");
+    assert!(!pick.hit);
+    assert_eq!(pick.walk, cells);
+    let said = h.get_by_label_contains("hits nothing in the grid");
+    assert!(format!("{said:?}").contains(&format!("walks {} cells", cells.len())));
+    assert!(
+        h.query_by_label("The ray misses every object: nothing to draw.")
+            .is_none(),
+        "the walk is drawn instead"
+    );
+    assert!(h.query_by_label("World space").is_some());
 }
