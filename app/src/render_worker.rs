@@ -11,6 +11,14 @@ use std::time::{Duration, Instant};
 use tracelab_core::render::{NormalGap, RenderPlan, normal_rule_gap, render};
 use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, Scene, SharedFrame};
 
+/// The course's uniform grid for the view (View › Uniform grid): `-grid NX NY NZ`, and
+/// `-visualize_grid`'s picture of its occupied cells in place of the render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GridRequest {
+    pub cells: [u32; 3],
+    pub visualize: bool,
+}
+
 /// What to render: one frame per normal rule in `modes` (two in compare mode).
 #[derive(Clone, Debug)]
 pub struct Job {
@@ -25,6 +33,8 @@ pub struct Job {
     pub submitted: Instant,
     /// Only the coarse passes (the view is being dragged).
     pub coarse: bool,
+    /// Render through the course's uniform grid (or show it) instead of the BVH.
+    pub grid: Option<GridRequest>,
 }
 
 /// The render the UI should show.
@@ -42,6 +52,9 @@ pub struct Published {
     /// The largest angle between the two normal rules over this render's pixels, computed
     /// after the full image (so it never delays it).
     pub normal_gap: Option<NormalGap>,
+    /// Why the grid the job asked for was not built (too many cells or entries): the render
+    /// went through the BVH instead, and the editor says so.
+    pub grid_error: Option<String>,
 }
 
 #[derive(Default)]
@@ -62,10 +75,17 @@ pub struct RenderWorker {
     requests: u64,
     /// Every setting of the last request (all of `RenderSettings`, so a new one such as the
     /// rays of View › Rays can never be left out of it), its normal rules and coarseness.
-    last_key: Option<(RenderSettings, Vec<NormalTransform>, bool)>,
+    last_key: Option<(
+        RenderSettings,
+        Vec<NormalTransform>,
+        bool,
+        Option<GridRequest>,
+    )>,
     /// Render only the coarse passes from now on (the view is being dragged); a request with
     /// this off renders the same generation again in full.
     pub coarse_only: bool,
+    /// The uniform grid of the requests from now on (View › Uniform grid); `None`: the BVH.
+    pub grid: Option<GridRequest>,
 }
 
 impl Default for RenderWorker {
@@ -96,6 +116,7 @@ impl RenderWorker {
             requests: 0,
             last_key: None,
             coarse_only: false,
+            grid: None,
         }
     }
 
@@ -134,7 +155,7 @@ impl RenderWorker {
         settings: RenderSettings,
         modes: Vec<NormalTransform>,
     ) -> bool {
-        let key = (settings, modes.clone(), self.coarse_only);
+        let key = (settings, modes.clone(), self.coarse_only, self.grid);
         if generation == self.last_generation && self.last_key.as_ref() == Some(&key) {
             return false;
         }
@@ -152,6 +173,7 @@ impl RenderWorker {
             modes,
             submitted: Instant::now(),
             coarse: self.coarse_only,
+            grid: self.grid,
         };
         if let Some(tx) = &self.tx {
             let _ = tx.send((job, self.cancel.clone()));
@@ -229,7 +251,15 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
         if cancel.load(Ordering::Relaxed) {
             continue;
         }
-        let compiled = Arc::new(CompiledScene::new(&job.scene));
+        let mut compiled = CompiledScene::new(&job.scene);
+        let grid_error = job.grid.and_then(|g| {
+            let [x, y, z] = g.cells;
+            compiled
+                .use_grid(glam::UVec3::new(x, y, z))
+                .err()
+                .map(|e| e.to_string())
+        });
+        let compiled = Arc::new(compiled);
         let frames: Vec<Arc<SharedFrame>> = job
             .modes
             .iter()
@@ -254,6 +284,7 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 first_image: None,
                 full: None,
                 normal_gap: None,
+                grid_error,
             };
             *p = Some(new);
         }
@@ -299,6 +330,22 @@ fn worker_loop(rx: &Receiver<(Job, Arc<AtomicBool>)>, shared: &Shared) {
                 ..job.settings
             };
             let pass = |info: tracelab_core::render::PassInfo| on_pass(i, info);
+            if job.grid.is_some_and(|g| g.visualize) && compiled.grid().is_some() {
+                // `-visualize_grid`'s picture, made in one go as the command line makes it.
+                let start = Instant::now();
+                frames[i].set(tracelab_core::render::visualize_grid(
+                    &compiled,
+                    settings.width,
+                    settings.height,
+                ));
+                pass(tracelab_core::render::PassInfo {
+                    pass: 0,
+                    passes: 1,
+                    scale: 1,
+                    elapsed: start.elapsed(),
+                });
+                return !cancel.load(Ordering::Relaxed);
+            }
             let plan = if job.coarse {
                 RenderPlan::COARSE
             } else {

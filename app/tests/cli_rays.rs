@@ -358,3 +358,36 @@ fn grid_flags_render_the_same_image_print_stats_and_refuse_hostile_counts() {
         assert!(!d.join("bad.png").exists());
     }
 }
+
+/// `-stats` on a line given to `diff` is never silently dropped: the reference render's
+/// counters are printed and named as such (before: nothing). Positive control: without
+/// `-stats` the block is absent.
+#[test]
+fn diff_prints_the_reference_renders_stats_when_its_line_asks_for_them() {
+    let d = common::temp_dir("rays", "diff-stats");
+    let s = repo()
+        .join("scenes/perspective_mesh.txt")
+        .display()
+        .to_string();
+    let line = ["-input", &s, "-size", "24", "24", "-output", "mine.png"];
+    let made = tracelab(&[&line[..], &["-grid", "5", "5", "5"]].concat(), &d);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let diff = |extra: &[&str]| {
+        let mut a = vec!["diff", "mine.png", "--"];
+        a.extend(line);
+        a.extend(["-grid", "5", "5", "5"]);
+        a.extend(extra);
+        tracelab(&a, &d)
+    };
+    let with = diff(&["-stats"]);
+    assert!(with.status.success(), "{}", stderr(&with));
+    let out = String::from_utf8_lossy(&with.stdout);
+    assert!(
+        out.contains("tracelab's reference render")
+            && out.contains("num grid cells                125 (5x5x5)"),
+        "{out}"
+    );
+    let without = diff(&[]);
+    assert!(without.status.success(), "{}", stderr(&without));
+    assert!(!String::from_utf8_lossy(&without.stdout).contains("RAY TRACING STATISTICS"));
+}

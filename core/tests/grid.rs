@@ -296,3 +296,282 @@ fn a_sphere_takes_only_the_cells_it_reaches_and_hostile_counts_are_refused() {
     assert!(c.grid().is_none());
     assert!(c.use_grid(UVec3::new(64, 64, 64)).is_ok());
 }
+
+/// The handout's registration rule, checked cell by cell from the entries' boxes alone
+/// (assignment 5): every entry (an object, or one triangle of a mesh) is listed in every
+/// cell its world box overlaps and in no other, so a cell touching no entry's box is empty.
+/// One deliberate exception, which grid_scene.rs documents: a sphere with no transform of its
+/// own is listed where the ball reaches (the handout's pictures leave its box's corners
+/// empty), so for it the ball stands in for the box. Cells whose overlap with a box is within
+/// a hair (1e-4 of a cell) may go either way: rounding decides. Returns the (cell, entry)
+/// pairs checked.
+fn check_registration(c: &CompiledScene, cells: UVec3, what: &str) -> usize {
+    let mut g = c.clone();
+    g.use_grid(cells).expect("grid");
+    let gs = g.grid().expect("a grid");
+    let grid = &gs.grid;
+    let (lo, n) = (grid.bounds.min, grid.cells);
+    let size = grid.bounds.extent() / n.as_vec3();
+    let eps = size * 1e-4;
+    let mut matched = 0usize;
+    for e in 0..gs.entry_count() as u32 {
+        let (i, tri) = gs.entry(e).expect("entry");
+        let o = &c.objects[i as usize];
+        let b = match tri {
+            None => c.object_world_bounds(i),
+            Some(k) => {
+                let Shape::Mesh(m) = &o.shape else {
+                    panic!("{what}: entry {e} names triangle {k} of a non-mesh")
+                };
+                let local = tracelab_core::geometry::Aabb::from_points(&m.triangle(k));
+                o.xf.as_ref().map_or(local, |xf| xf.world_bounds(local))
+            }
+        };
+        if b.is_empty() || !b.is_finite() {
+            continue;
+        }
+        let ball = match (&o.shape, &o.xf, tri) {
+            (Shape::Sphere { center, radius }, None, None) => Some((*center, *radius)),
+            _ => None,
+        };
+        // The cells the box could touch, widened by one: the rest are far from it.
+        let first = ((b.min - lo) / size).floor() - Vec3::ONE;
+        let last = ((b.max - lo) / size).floor() + Vec3::ONE;
+        let clamp = |v: Vec3| v.clamp(Vec3::ZERO, (n - UVec3::ONE).as_vec3()).as_uvec3();
+        let (first, last) = (clamp(first), clamp(last));
+        for z in first.z..=last.z {
+            for y in first.y..=last.y {
+                for x in first.x..=last.x {
+                    let cell = UVec3::new(x, y, z);
+                    let cmin = lo + cell.as_vec3() * size;
+                    let cmax = cmin + size;
+                    // Overlap of the closed boxes along each axis (negative: a gap).
+                    let overlap = b.max.min(cmax) - b.min.max(cmin);
+                    let (inside, outside) = match ball {
+                        None => ((overlap.cmpgt(eps)).all(), (overlap.cmplt(-eps)).any()),
+                        Some((ctr, r)) => {
+                            let d = ctr.clamp(cmin, cmax).distance(ctr);
+                            let h = eps.max_element();
+                            (d < r - h, d > r + h)
+                        }
+                    };
+                    let listed = grid.entries(cell).contains(&e);
+                    assert!(
+                        listed || !inside,
+                        "{what}: grid {cells}: entry {e} (object {i}, triangle {tri:?}) \
+                         overlaps cell {cell} but is not listed there"
+                    );
+                    assert!(
+                        !listed || !outside,
+                        "{what}: grid {cells}: entry {e} (object {i}) is listed in cell \
+                         {cell}, which its box does not touch"
+                    );
+                    matched += usize::from(listed);
+                }
+            }
+        }
+    }
+    // Every listing was met above, near its entry's box: none lies anywhere else, so a cell
+    // that no box touches holds nothing.
+    let total: usize = grid.occupied_cells().map(|(_, k)| k).sum();
+    assert_eq!(
+        matched, total,
+        "{what}: grid {cells}: some cell lists an entry far from the entry's box"
+    );
+    total
+}
+
+/// A ray's walk through the grid against a brute force over every cell: the cells come in
+/// order of increasing entry t, each next to the last (one face apart) and entered where the
+/// last was left; each is a cell whose box the ray crosses; and every cell whose box the
+/// ray's segment crosses before the hit (by more than a hair) is among them. The walk goes no
+/// further than the cell holding the hit, which is the closest hit `intersect` finds. Returns the
+/// cells checked.
+fn check_walk(g: &CompiledScene, ray: &Ray, t_min: f32, what: &str) -> usize {
+    let grid = &g.grid().expect("a grid").grid;
+    let walk = g.grid_walk(ray, t_min, f32::INFINITY).expect("a grid walk");
+    assert_eq!(
+        walk.hit,
+        g.intersect(ray, t_min, f32::INFINITY),
+        "{what}: the walk's hit is intersect's"
+    );
+    for w in walk.cells.windows(2) {
+        assert!(
+            w[0].t_enter <= w[1].t_enter,
+            "{what}: {ray:?}: out of order {w:?}"
+        );
+        assert_eq!(w[0].t_exit, w[1].t_enter, "{what}: {ray:?}: gap {w:?}");
+        let moved = (w[1].cell.as_ivec3() - w[0].cell.as_ivec3()).abs();
+        assert_eq!(
+            moved.element_sum(),
+            1,
+            "{what}: {ray:?}: not adjacent {w:?}"
+        );
+    }
+    let size = grid.bounds.extent() / grid.cells.as_vec3();
+    let tol = 1e-3 * size.max_element() / ray.direction.length();
+    let t_end = walk.hit.map_or(f32::INFINITY, |h| h.t);
+    // The ray's span in each cell, by the slab test on the cell's own box; a ray parallel to
+    // an axis counts as inside the slab within `slack` cells of its faces (positive: what
+    // rounding may put in, negative: what it must).
+    let span_within = |c: UVec3, slack: f32| {
+        let cmin = grid.bounds.min + c.as_vec3() * size;
+        let cmax = cmin + size;
+        let (mut near, mut far) = (t_min, f32::INFINITY);
+        for k in 0..3 {
+            let (o, d) = (ray.origin[k], ray.direction[k]);
+            if d == 0.0 {
+                // Parallel to this slab: inside it (its faces, within rounding, included)
+                // or never.
+                let h = slack * size[k];
+                if o < cmin[k] - h || o > cmax[k] + h {
+                    return (f32::INFINITY, f32::NEG_INFINITY);
+                }
+                continue;
+            }
+            let (a, b) = ((cmin[k] - o) / d, (cmax[k] - o) / d);
+            near = near.max(a.min(b));
+            far = far.min(a.max(b));
+        }
+        (near, far)
+    };
+    for v in &walk.cells {
+        let (near, far) = span_within(v.cell, 1e-4);
+        assert!(
+            far - near > -tol && (v.t_enter - near).abs() <= tol,
+            "{what}: {ray:?}: walked cell {} is not crossed there: {v:?}, box span {near}..{far}",
+            v.cell
+        );
+    }
+    if let (Some(h), Some(last)) = (walk.hit, walk.cells.last()) {
+        // No cell past the hit's (a plane's hit may lie beyond the grid: then all of it).
+        assert!(
+            h.t >= last.t_enter - tol,
+            "{what}: {ray:?}: the walk goes on to {last:?}, past the hit at t {}",
+            h.t
+        );
+    }
+    let mut brute = Vec::new();
+    for z in 0..grid.cells.z {
+        for y in 0..grid.cells.y {
+            for x in 0..grid.cells.x {
+                let c = UVec3::new(x, y, z);
+                let (near, far) = span_within(c, -1e-4);
+                if far - near > tol && near < t_end - tol {
+                    brute.push((near, c));
+                }
+            }
+        }
+    }
+    brute.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let walked: Vec<UVec3> = walk.cells.iter().map(|v| v.cell).collect();
+    let mut at = 0;
+    for (near, c) in &brute {
+        let Some(k) = walked[at..].iter().position(|w| w == c) else {
+            panic!(
+                "{what}: {ray:?}: the segment crosses cell {c} from t {near}, but the walk \
+                 {walked:?} does not visit it (in order)"
+            );
+        };
+        at += k;
+    }
+    walk.cells.len()
+}
+
+/// Registration and walks on one scene at one grid size.
+fn check_grid_properties(c: &CompiledScene, cells: UVec3, rays: u32, what: &str) -> (usize, usize) {
+    let pairs = check_registration(c, cells, what);
+    let mut g = c.clone();
+    g.use_grid(cells).expect("grid");
+    let mut walked = 0;
+    for row in 0..rays {
+        for x in 0..rays {
+            let ray = g.camera.pixel_ray(x, row, rays, rays);
+            walked += check_walk(&g, &ray, g.camera.t_min(), what);
+        }
+    }
+    (pairs, walked)
+}
+
+#[test]
+fn each_entry_sits_in_the_cells_its_box_overlaps_and_rays_walk_them_in_order_on_our_scenes() {
+    let (mut pairs, mut walked, mut scenes) = (0, 0, 0);
+    for p in scene_files(&common::repo().join("scenes"))
+        .into_iter()
+        .filter(|p| !p.components().any(|c| c.as_os_str() == "perf"))
+    {
+        let Some(c) = compiled(&p) else { continue };
+        for cells in [UVec3::new(9, 7, 5), UVec3::splat(16)] {
+            let (a, b) = check_grid_properties(&c, cells, 12, &p.display().to_string());
+            pairs += a;
+            walked += b;
+        }
+        scenes += 1;
+    }
+    println!("{scenes} scenes: {pairs} (cell, entry) pairs, {walked} walked cells checked");
+    assert!(
+        scenes >= 20 && pairs > 10_000 && walked > 10_000,
+        "{scenes} {pairs} {walked}"
+    );
+}
+
+/// The assignment 5 lines of the semester's commands.txt: scene file and -grid sizes.
+fn assignment5_lines(dir: &Path) -> Vec<(String, UVec3)> {
+    let text = std::fs::read_to_string(dir.join("commands.txt")).expect("commands.txt");
+    let mut out = Vec::new();
+    for line in text.lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let arg = |flag: &str, k: usize| {
+            words
+                .iter()
+                .position(|w| *w == flag)
+                .and_then(|i| words.get(i + k))
+                .copied()
+        };
+        let Some(scene) = arg("-input", 1).filter(|s| s.starts_with("scene5_")) else {
+            continue;
+        };
+        let n = |k| {
+            arg("-grid", k)
+                .and_then(|v| v.parse::<u32>().ok())
+                .expect("-grid N")
+        };
+        out.push((scene.to_string(), UVec3::new(n(1), n(2), n(3))));
+    }
+    out
+}
+
+#[test]
+#[ignore = "needs ../shared/mit6837-semester (TRACELAB_SEMESTER_DIR)"]
+fn each_entry_sits_in_the_cells_its_box_overlaps_and_rays_walk_them_in_order_on_assignment_5() {
+    let dir = common::semester_dir();
+    let lines = assignment5_lines(&dir);
+    assert_eq!(
+        lines.len(),
+        15,
+        "the handout's assignment 5 lines: {lines:?}"
+    );
+    for (scene, cells) in lines {
+        let p = dir.join("scenes").join(&scene);
+        let c = compiled(&p).unwrap_or_else(|| panic!("{scene} does not load"));
+        let (pairs, walked) = check_grid_properties(&c, cells, 16, &scene);
+        println!("{scene} -grid {cells}: {pairs} (cell, entry) pairs, {walked} walked cells");
+        assert!(pairs > 0 && walked > 0, "{scene}");
+    }
+}
+
+#[test]
+fn the_registration_check_catches_a_missing_and_a_stray_listing() {
+    // Positive control for check_registration's arithmetic: a unit box in a 4³ grid over
+    // [0, 4]³ overlaps exactly the cells its corners fall in.
+    let g = tracelab_core::accel::UniformGrid::build(
+        tracelab_core::geometry::Aabb::new(Vec3::ZERO, Vec3::splat(4.0)),
+        UVec3::splat(4),
+        &[tracelab_core::geometry::Aabb::new(
+            Vec3::splat(1.2),
+            Vec3::new(2.5, 1.8, 1.4),
+        )],
+    );
+    let listed: Vec<UVec3> = g.occupied_cells().map(|(c, _)| c).collect();
+    assert_eq!(listed, [UVec3::new(1, 1, 1), UVec3::new(2, 1, 1)]);
+}

@@ -221,6 +221,15 @@ pub fn run_batch(a: &DiffArgs, commands: &Path, c: &Criterion) -> anyhow::Result
     let (mut failed_lines, mut images_total, mut images_ok) = (0, 0, 0);
     let mut inlined = 0;
     for p in planned {
+        if p.job.as_ref().is_ok_and(|j| j.stats) {
+            // Never silently ignored: the report has no place for the counters.
+            write_stderr_text(&format!(
+                "warning: {}:{}: -stats is not printed by --batch (it judges images); \
+                 `tracelab diff IMAGE -- LINE` prints the reference render's counters\n",
+                commands.display(),
+                p.line.number
+            ));
+        }
         let row = judge_planned(p, a, c, &mut plan, &mut inlined);
         for img in &row.images {
             images_total += 1;

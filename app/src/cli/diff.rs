@@ -312,12 +312,14 @@ fn check<'s>(c: &Criterion, r: &Reference, s: &'s Student<'s>) -> anyhow::Result
     })
 }
 
-/// A line judged: the diagnosis (empty when every image matches), each image's verdict, and
-/// the regions of off pixels with their stories.
+/// A line judged: the diagnosis (empty when every image matches), each image's verdict, the
+/// regions of off pixels with their stories, and, when the line asks for `-stats`, the
+/// counters of the reference render (tracelab's, not the student program's).
 pub(super) struct Judgement<'s> {
     pub diagnosis: String,
     pub verdicts: Vec<Verdict<'s>>,
     pub regions: String,
+    pub stats: Option<String>,
 }
 
 impl Judgement<'_> {
@@ -347,7 +349,15 @@ pub(super) fn judge_line<'s>(
         secondary: job.secondary,
         ..RenderSettings::new(job.width, job.height)
     };
+    let start = std::time::Instant::now();
     let frame = frame_for(job, &compiled, &settings)?;
+    let stats = job.stats.then(|| {
+        format!(
+            "-stats: the counters of tracelab's reference render for this line (not of your \
+             program's run):\n{}",
+            super::stats::stats_text(&compiled, &settings, start.elapsed())
+        )
+    });
     let r = Reference {
         scene: &scene,
         compiled: &compiled,
@@ -384,6 +394,7 @@ pub(super) fn judge_line<'s>(
         diagnosis,
         verdicts,
         regions,
+        stats,
     })
 }
 
@@ -565,7 +576,8 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     }
     let j = judge_line(&job, &students, &criterion, a.regions, &mut plan)?;
     let mut failed = Vec::new();
-    let mut out = j.diagnosis.clone();
+    let mut out = j.stats.clone().unwrap_or_default();
+    out.push_str(&j.diagnosis);
     for v in &j.verdicts {
         out.push_str(&v.text);
         if let Some(d) = &v.decoded {

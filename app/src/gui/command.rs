@@ -63,6 +63,8 @@ pub enum AppCommand {
     RayDiagramsInWindow(bool),
     /// Shadows, bounces, weight and the specular fix of the view (View › Rays).
     SetRays(tracelab_core::render::Secondary),
+    /// Render through the course's uniform grid, or show it (View › Uniform grid).
+    SetGrid(crate::gui::grid_view::GridSettings),
     ResetLayout,
     /// Move the camera to show the selected node whole (F).
     FrameSelected,

@@ -8,6 +8,7 @@ pub mod drag_speed;
 pub mod file_dialog;
 pub mod file_watch;
 pub mod gizmo;
+pub mod grid_view;
 pub mod layout;
 pub mod lecture;
 pub mod light_gizmo;

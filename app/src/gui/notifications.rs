@@ -118,3 +118,18 @@ pub fn disk_changed(ctx: &egui::Context, over: egui::Rect) -> Option<DiskAnswer>
         });
     answer
 }
+
+/// A warning about what the view shows (a refused grid), over the bottom of `over` (the
+/// view) for as long as it holds, never a row that pushes the layout.
+pub fn view_warning(ctx: &egui::Context, over: egui::Rect, text: &str) {
+    egui::Area::new(egui::Id::unique("tracelab-view-warning"))
+        .order(egui::Order::Foreground)
+        .pivot(egui::Align2::CENTER_BOTTOM)
+        .fixed_pos(over.center_bottom() - egui::vec2(0.0, 8.0))
+        .constrain_to(over)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.colored_label(colour(ui, Level::Warning), text);
+            });
+        });
+}

@@ -30,6 +30,10 @@ pub enum Role {
     Shadow,
     /// A shadow ray stopped by an object: it ends at the blocker.
     ShadowBlocked,
+    /// An occupied cell of the uniform grid (View › Uniform grid).
+    GridCell,
+    /// A cell the eye ray walks through in the grid, numbered in DDA order.
+    GridWalk,
 }
 
 impl Role {

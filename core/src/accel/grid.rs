@@ -129,6 +129,23 @@ impl UniformGrid {
         self.offsets.windows(2).filter(|w| w[1] > w[0]).count()
     }
 
+    /// Every cell holding at least one entry, with how many, in index order (x fastest).
+    pub fn occupied_cells(&self) -> impl Iterator<Item = (UVec3, usize)> + '_ {
+        let (nx, ny) = (self.cells.x as usize, self.cells.y as usize);
+        self.offsets
+            .windows(2)
+            .enumerate()
+            .filter_map(move |(k, w)| {
+                let n = (w[1] - w[0]) as usize;
+                let c = UVec3::new(
+                    (k % nx) as u32,
+                    (k / nx % ny) as u32,
+                    (k / (nx * ny)) as u32,
+                );
+                (n > 0).then_some((c, n))
+            })
+    }
+
     /// The entries of cell `c`.
     pub fn entries(&self, c: UVec3) -> &[u32] {
         let k = self.index(c);

@@ -16,6 +16,20 @@ pub struct GridScene {
     pub stats: RayCounts,
 }
 
+impl GridScene {
+    /// What grid entry `e` stands for: (object index, `Some(triangle)` of a mesh or `None`
+    /// for the whole object).
+    pub fn entry(&self, e: u32) -> Option<(u32, Option<u32>)> {
+        let &(i, k) = self.items.get(e as usize)?;
+        Some((i, (k != WHOLE).then_some(k)))
+    }
+
+    /// How many entries the grid was built from (objects and mesh triangles).
+    pub fn entry_count(&self) -> usize {
+        self.items.len()
+    }
+}
+
 /// The course's `-stats` counters (`RayTracingStats`), counted while a grid is in use.
 #[derive(Debug, Default)]
 pub struct RayCounts {

@@ -14,6 +14,14 @@ use super::grid_data::{GridScene, RayCounts, WHOLE};
 use crate::accel::{CellVisit, MAX_CELLS, MAX_ENTRIES, UniformGrid};
 use crate::geometry::{Aabb, Ray, moller_trumbore};
 
+/// The cells one ray walks through, nearest first, and the closest hit it found
+/// ([`CompiledScene::grid_walk`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridWalk {
+    pub cells: Vec<CellVisit>,
+    pub hit: Option<Hit>,
+}
+
 /// Why a grid could not be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum GridError {
@@ -111,31 +119,62 @@ impl CompiledScene {
         t_min: f32,
         t_max: f32,
     ) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut t_best = t_max;
-        for &i in &self.unbounded {
-            self.offer_item(i, WHOLE, ray, t_min, &mut t_best, &mut best);
-        }
         let (mut cells, mut tests) = (0u64, 0u64);
-        g.grid
-            .walk(ray.origin, ray.direction, t_min, t_max, |v: &CellVisit| {
-                cells += 1;
-                for &e in g.grid.entries(v.cell) {
-                    if let Some(&(i, k)) = g.items.get(e as usize) {
-                        tests += 1;
-                        self.offer_item(i, k, ray, t_min, &mut t_best, &mut best);
-                    }
-                }
-                // An object may reach past this cell: its hit counts only once no later
-                // cell can hold a nearer one.
-                !(best.is_some() && t_best <= v.t_exit)
-            });
+        let best = self.walk_grid(g, ray, t_min, t_max, |_, n| {
+            cells += 1;
+            tests += n as u64;
+        });
         RayCounts::add(&g.stats.cells_traversed, cells);
         RayCounts::add(
             &g.stats.intersection_tests,
             tests + self.unbounded.len() as u64,
         );
         best
+    }
+
+    /// The one grid traversal behind [`Self::intersect_grid`] and [`Self::grid_walk`]: planes
+    /// first, then the cells along the ray in DDA order, `on_cell(visit, entries tested)` for
+    /// each, stopping once the nearest hit so far lies in the cell being left.
+    fn walk_grid(
+        &self,
+        g: &GridScene,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        mut on_cell: impl FnMut(&CellVisit, usize),
+    ) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_best = t_max;
+        for &i in &self.unbounded {
+            self.offer_item(i, WHOLE, ray, t_min, &mut t_best, &mut best);
+        }
+        // Past a plane's hit no cell can hold a nearer one: the walk stops there.
+        g.grid
+            .walk(ray.origin, ray.direction, t_min, t_best, |v: &CellVisit| {
+                let mut tested = 0;
+                for &e in g.grid.entries(v.cell) {
+                    if let Some(&(i, k)) = g.items.get(e as usize) {
+                        tested += 1;
+                        self.offer_item(i, k, ray, t_min, &mut t_best, &mut best);
+                    }
+                }
+                on_cell(v, tested);
+                // An object may reach past this cell: its hit counts only once no later
+                // cell can hold a nearer one.
+                !(best.is_some() && t_best <= v.t_exit)
+            });
+        best
+    }
+
+    /// The cells a ray walks through in the grid, in DDA order, up to and including the
+    /// cell holding its closest hit (all the way through the grid when it hits nothing
+    /// there), with that hit: what `intersect` does for this ray, listed (the editor's Ray
+    /// panel draws it). `None` without a grid. The `-stats` counters are left alone.
+    pub fn grid_walk(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<GridWalk> {
+        let g = self.grid()?;
+        let mut cells = Vec::new();
+        let hit = self.walk_grid(g, ray, t_min, t_max, |v, _| cells.push(*v));
+        Some(GridWalk { cells, hit })
     }
 
     /// Offers object `i` (or its triangle `k`) to a ray, as `offer` does for the BVH.

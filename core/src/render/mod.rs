@@ -27,7 +27,7 @@ pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, PointLight, Shape};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use grid_data::{GridScene, RayCounts};
-pub use grid_scene::{GridError, grid_cell_color, visualize_grid};
+pub use grid_scene::{GridError, GridWalk, grid_cell_color, visualize_grid};
 pub use inspect::{HitStory, PathStep, RayStory, inspect_pixel};
 pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_size};
 pub use mistakes::{Mistake, Variant};

@@ -67,6 +67,12 @@ impl SharedFrame {
     pub fn take(&self) -> Frame {
         std::mem::replace(&mut *self.lock(), Frame::new(0, 0))
     }
+    /// Puts a whole finished image in place (one not rendered by passes, such as
+    /// `-visualize_grid`'s), so readers see it as new.
+    pub fn set(&self, frame: Frame) {
+        *self.lock() = frame;
+        self.bump();
+    }
     pub fn version(&self) -> u64 {
         self.version.load(Ordering::Acquire)
     }

@@ -106,6 +106,7 @@ impl TracelabApp {
             AppCommand::ShowRayPanel(open) => self.ray_panel_open = open,
             AppCommand::RayDiagramsInWindow(w) => self.ray_window = w,
             AppCommand::SetRays(rays) => self.view.secondary = rays,
+            AppCommand::SetGrid(grid) => self.grid = grid,
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {
                 Some(Selection::Node(id)) => self.frame_node(id),

@@ -21,6 +21,7 @@ use crate::gui::animation_dialog::{self, AnimationForm};
 use crate::gui::command::AppCommand;
 use crate::gui::file_dialog::{FileDialog, Purpose};
 use crate::gui::file_watch::{self, FileWatch};
+use crate::gui::grid_view::{self, GridPick, GridSettings};
 use crate::gui::layout::Layout;
 use crate::gui::lecture;
 use crate::gui::loading::{LoadPurpose, Loading};
@@ -92,6 +93,11 @@ pub struct TracelabApp {
     /// A figure whose scene is being read (or waits for the unsaved-changes answer): its view
     /// and caption are applied when that scene is installed, and dropped if it is not.
     pending_lecture: Option<usize>,
+    /// View › Uniform grid: the course's grid instead of the BVH, or its picture.
+    pub grid: GridSettings,
+    /// The grid and the inspected pixel's walk through it, while the render on screen went
+    /// through a grid (drawn in the Ray panel's world diagram).
+    pub grid_pick: Option<GridPick>,
     /// How each Ray diagram (world, object) is turned.
     pub ray_orbits: [Orbit; 2],
     pub dialog: Option<FileDialog>,
@@ -148,6 +154,8 @@ impl TracelabApp {
             ray_panel_open: true,
             ray_window: false,
             ray_orbits: [Orbit::default(); 2],
+            grid: GridSettings::default(),
+            grid_pick: None,
             lecture: None,
             pending_lecture: None,
             animation: None,

@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 use tracelab_core::Scene;
 use tracelab_core::render::RayStory;
 
+use crate::gui::grid_view::GridPick;
 use crate::gui::ray_diagram::{Diagram, Orbit, Role, Shape, diagrams};
 
 fn color(role: Role) -> Color32 {
@@ -27,6 +28,8 @@ fn color(role: Role) -> Color32 {
         Role::Refracted => Color32::from_rgb(200, 120, 255),
         Role::Shadow => Color32::from_rgb(170, 170, 140),
         Role::ShadowBlocked => Color32::from_rgb(255, 70, 70),
+        Role::GridCell => Color32::from_rgba_unmultiplied(120, 130, 150, 45),
+        Role::GridWalk => Color32::from_rgb(255, 150, 40),
     }
 }
 
@@ -42,7 +45,7 @@ fn line(painter: &egui::Painter, role: Role, pts: Vec<Pos2>) {
                 3.0,
             ));
         }
-        Role::Ray | Role::Reflected | Role::Refracted => {
+        Role::Ray | Role::Reflected | Role::Refracted | Role::GridWalk => {
             painter.line(pts, Stroke::new(2.0, c));
         }
         _ => {
@@ -288,16 +291,41 @@ pub fn place_labels(
     placed
 }
 
-/// Both diagrams side by side, or a line saying why there are none.
-pub fn ui(ui: &mut egui::Ui, story: Option<(&RayStory, &Scene)>, orbits: &mut [Orbit; 2]) {
+/// Both diagrams side by side, or a line saying why there are none. With a uniform grid in
+/// use, the world diagram also draws its occupied cells and the cells the ray walks.
+pub fn ui(
+    ui: &mut egui::Ui,
+    story: Option<(&RayStory, &Scene)>,
+    orbits: &mut [Orbit; 2],
+    grid: Option<&GridPick>,
+) {
     let Some((story, scene)) = story else {
         ui.label("Click a pixel in the render view to draw its ray.");
         return;
     };
-    let Some((world, object)) = diagrams(scene, story) else {
+    let Some((mut world, object)) = diagrams(scene, story) else {
+        if let Some(g) = grid {
+            // No hit, but a walk through the grid to draw.
+            ui.label(egui::RichText::new(g.summary()).small());
+            let avail = ui.available_size();
+            let side = egui::vec2(avail.x.max(120.0), (avail.y - 24.0).max(120.0));
+            draw(
+                ui,
+                "world",
+                "World space",
+                &g.miss_diagram(),
+                &mut orbits[0],
+                side,
+            );
+            return;
+        }
         ui.label("The ray misses every object: nothing to draw.");
         return;
     };
+    if let Some(g) = grid {
+        ui.label(egui::RichText::new(g.summary()).small());
+        world.items.extend(g.items.iter().cloned());
+    }
     let avail = ui.available_size();
     let side = egui::vec2(
         ((avail.x - 16.0) / 2.0).max(120.0),
