@@ -119,6 +119,21 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut S
     store_sample(scene, dst, hit.as_ref(), shaded);
 }
 
+/// The colour one ray brings back, before quantisation (the background for a miss): what a
+/// supersampled render averages.
+pub(super) fn trace_color(scene: &CompiledScene, s: &RenderSettings, ray: &Ray) -> glam::Vec3 {
+    let hit = if s.object_rays == ObjectRays::Unnormalized {
+        scene.intersect(ray, scene.camera.t_min(), f32::INFINITY)
+    } else {
+        scene.intersect_with(ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
+    };
+    match hit {
+        None => scene.background,
+        Some(h) if needs_whitted(scene, s) => shade_primary(scene, ray, &h, s).0,
+        Some(h) => shade_fast(scene, ray, &h, s).0,
+    }
+}
+
 /// Traces the grid points `pts` (grid coordinates of one tile's pass, in the order
 /// `points_to_trace` gives them: 4×2 neighbourhoods) eight rays at a time, storing each sample
 /// at its place in `grid` (row-major, `gw` points a row).
