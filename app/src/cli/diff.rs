@@ -546,6 +546,7 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         ));
     }
     let job: RenderJob = parse_course_args(&a.course)?;
+    job.supersample.refuse_pictures("diff")?;
     check_size(job.width, job.height)?;
     let size = (job.width, job.height);
     // Heat maps are invented names: never a file this command reads or the line names.

@@ -19,6 +19,7 @@ mod regions;
 mod render;
 mod report_html;
 mod stats;
+mod supersample;
 mod values;
 
 use std::borrow::Cow;
