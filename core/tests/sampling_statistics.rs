@@ -70,7 +70,7 @@ fn over_seeds(
     seeds: impl Iterator<Item = u64>,
 ) -> (Vec<f64>, Vec<f64>) {
     let images: Vec<Vec<f64>> = seeds
-        .map(|s| image(scene, Sampler::new(kind, n, s).unwrap()))
+        .map(|s| image(scene, Sampler::new(kind, n, s).expect("a valid test value")))
         .collect();
     let k = images.len() as f64;
     let px = images[0].len();
@@ -79,7 +79,11 @@ fn over_seeds(
         .collect();
     let var = (0..px)
         .map(|p| {
-            images.iter().map(|im| (im[p] - mean[p]).powi(2)).sum::<f64>() / (k - 1.0)
+            images
+                .iter()
+                .map(|im| (im[p] - mean[p]).powi(2))
+                .sum::<f64>()
+                / (k - 1.0)
         })
         .collect();
     (mean, var)
@@ -88,7 +92,7 @@ fn over_seeds(
 fn exact(scene: &CompiledScene) -> Vec<f64> {
     image(
         scene,
-        Sampler::new(SamplerKind::Uniform, 64 * 64, 0).unwrap(),
+        Sampler::new(SamplerKind::Uniform, 64 * 64, 0).expect("a valid test value"),
     )
 }
 
@@ -145,7 +149,11 @@ fn the_spread_shrinks_as_one_over_root_n() {
     let (_, v4) = over_seeds(&scene, SamplerKind::Random, 4, 1000..1000 + SEEDS);
     let (_, v16) = over_seeds(&scene, SamplerKind::Random, 16, 2000..2000 + SEEDS);
     let edge = edge_pixels(&scene);
-    let (s1, s4, s16) = (pooled_sd(&v1, &edge), pooled_sd(&v4, &edge), pooled_sd(&v16, &edge));
+    let (s1, s4, s16) = (
+        pooled_sd(&v1, &edge),
+        pooled_sd(&v4, &edge),
+        pooled_sd(&v16, &edge),
+    );
     for (a, b, what) in [(s1, s4, "1 → 4"), (s4, s16, "4 → 16")] {
         let ratio = a / b;
         println!("{what} samples: spread {a:.4} → {b:.4}, ratio {ratio:.2}");
@@ -163,7 +171,13 @@ fn jittered_sampling_spreads_less_than_random_at_the_same_count() {
     let (_, vj) = over_seeds(&scene, SamplerKind::Jittered, 16, 0..SEEDS);
     let edge = edge_pixels(&scene);
     let (r, j) = (pooled_sd(&vr, &edge).powi(2), pooled_sd(&vj, &edge).powi(2));
-    println!("16 samples: jittered variance {j:.5}, random {r:.5}, ratio {:.2}", j / r);
-    assert!(j > 0.0, "jittered sampling with no spread at all ignores its seed");
+    println!(
+        "16 samples: jittered variance {j:.5}, random {r:.5}, ratio {:.2}",
+        j / r
+    );
+    assert!(
+        j > 0.0,
+        "jittered sampling with no spread at all ignores its seed"
+    );
     assert!(j < 0.6 * r, "jittered variance {j:.5} vs random {r:.5}");
 }

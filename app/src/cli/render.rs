@@ -83,6 +83,9 @@ pub struct SamplingArgs {
     pub render_filter: Option<Vec<OsString>>,
 }
 
+/// A filter from its one number, checked (`Filter::box_filter`, `tent`, `gaussian`).
+type MakeFilter = fn(f32) -> Result<Filter, FilterError>;
+
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SamplerMode {
     Uniform,
@@ -102,7 +105,7 @@ impl SamplingArgs {
             };
             s.set_sampler(kind, n, "--samples")?;
         }
-        let filters: [(&Option<OsString>, &str, fn(f32) -> Result<Filter, FilterError>); 3] = [
+        let filters: [(&Option<OsString>, &str, MakeFilter); 3] = [
             (&self.box_filter, "--box-filter", Filter::box_filter),
             (&self.tent_filter, "--tent-filter", Filter::tent),
             (&self.gaussian_filter, "--gaussian-filter", Filter::gaussian),

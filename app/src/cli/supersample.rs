@@ -51,7 +51,12 @@ impl Supersample {
     }
 
     /// `FLAG N`: a sampler of N samples a pixel; a second sampler flag is refused.
-    pub fn set_sampler(&mut self, kind: SamplerKind, value: &OsStr, flag: &str) -> anyhow::Result<()> {
+    pub fn set_sampler(
+        &mut self,
+        kind: SamplerKind,
+        value: &OsStr,
+        flag: &str,
+    ) -> anyhow::Result<()> {
         let n = parse_u32(value, flag)?;
         if let Some((_, _, first)) = &self.sampler {
             return Err(usage(format!(
@@ -100,7 +105,11 @@ impl Supersample {
     }
 
     /// `FLAG FILE ZOOM` for either picture.
-    pub fn picture(file: &OsStr, zoom: &OsStr, flag: &str) -> anyhow::Result<(PathBuf, u32, String)> {
+    pub fn picture(
+        file: &OsStr,
+        zoom: &OsStr,
+        flag: &str,
+    ) -> anyhow::Result<(PathBuf, u32, String)> {
         let zoom = parse_u32(zoom, &format!("{flag} zoom"))?;
         Ok((PathBuf::from(file), zoom, flag.to_string()))
     }
@@ -170,12 +179,8 @@ impl Supersample {
             v.join(" with ")
         };
         if self.filters_the_output() || self.render_samples.is_some() {
-            check_film(width, height, &sampler, &filter).map_err(|e| {
-                usage(format!(
-                    "{}: {e}",
-                    name(&self.filter, &self.sampler)
-                ))
-            })?;
+            check_film(width, height, &sampler, &filter)
+                .map_err(|e| usage(format!("{}: {e}", name(&self.filter, &self.sampler))))?;
         }
         if let Some((_, zoom, flag)) = &self.render_samples {
             samples_picture_size(width, height, *zoom)

@@ -9,13 +9,13 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use thiserror::Error;
 
+use super::RenderSettings;
 use super::compile::CompiledScene;
 use super::filter::Filter;
 use super::frame::{Frame, Sample, quantize};
 use super::limits::{ImageSizeError, check_image_size};
 use super::progressive::trace_color;
 use super::sampling::{Sampler, SamplerError};
-use super::RenderSettings;
 use crate::memory::{OutOfMemory, try_vec};
 
 /// Most weights one filtered image may evaluate (pixels × samples a pixel × pixels in the
@@ -283,9 +283,7 @@ fn zoomed(
     extra: u64,
     what: &'static str,
 ) -> Result<(u32, u32), FilmError> {
-    let side = |s: u32| {
-        u32::try_from(u64::from(s) * u64::from(zoom) + extra).unwrap_or(u32::MAX)
-    };
+    let side = |s: u32| u32::try_from(u64::from(s) * u64::from(zoom) + extra).unwrap_or(u32::MAX);
     let (w, h) = (side(width), side(height));
     check_image_size(w, h).map_err(|source| FilmError::ImageSize { what, source })?;
     Ok((w, h))
@@ -337,7 +335,7 @@ mod tests {
     /// A 3 × 1 film of one centred sample a pixel: red, green, blue.
     fn rgb_strip() -> Film {
         let colors = vec![Vec3::X, Vec3::Y, Vec3::Z];
-        Film::from_colors(3, 1, Sampler::default(), colors).unwrap()
+        Film::from_colors(3, 1, Sampler::default(), colors).expect("a valid test value")
     }
 
     #[test]
@@ -351,35 +349,46 @@ mod tests {
     #[test]
     fn a_wide_box_averages_the_neighbours_inside_the_image() {
         let f = rgb_strip();
-        let b = Filter::box_filter(1.5).unwrap();
+        let b = Filter::box_filter(1.5).expect("a valid test value");
         let third = Vec3::splat(1.0 / 3.0);
         assert!((f.filtered(&b, 1, 0) - third).abs().max_element() < 1e-6);
         // At the edge only the pixels inside the image count.
-        assert!((f.filtered(&b, 0, 0) - Vec3::new(0.5, 0.5, 0.0)).abs().max_element() < 1e-6);
+        assert!(
+            (f.filtered(&b, 0, 0) - Vec3::new(0.5, 0.5, 0.0))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
     }
 
     #[test]
     fn a_tent_weighs_neighbours_by_distance() {
         let f = rgb_strip();
-        let t = Filter::tent(2.0).unwrap();
+        let t = Filter::tent(2.0).expect("a valid test value");
         // Weights 1 (own), 0.5 (each neighbour at distance 1): (0.5, 1, 0.5)/2.
         let c = f.filtered(&t, 1, 0);
-        assert!((c - Vec3::new(0.25, 0.5, 0.25)).abs().max_element() < 1e-6, "{c}");
+        assert!(
+            (c - Vec3::new(0.25, 0.5, 0.25)).abs().max_element() < 1e-6,
+            "{c}"
+        );
     }
 
     #[test]
     fn where_every_weight_is_zero_the_pixel_is_black() {
-        let s = Sampler::new(SamplerKind::Uniform, 4, 0).unwrap();
-        let f = Film::from_colors(1, 1, s, vec![Vec3::ONE; 4]).unwrap();
+        let s = Sampler::new(SamplerKind::Uniform, 4, 0).expect("a valid test value");
+        let f = Film::from_colors(1, 1, s, vec![Vec3::ONE; 4]).expect("a valid test value");
         // Samples at ±¼ from the centre; a box of radius 0.1 holds none.
-        assert_eq!(f.filtered(&Filter::box_filter(0.1).unwrap(), 0, 0), Vec3::ZERO);
+        assert_eq!(
+            f.filtered(&Filter::box_filter(0.1).expect("a valid test value"), 0, 0),
+            Vec3::ZERO
+        );
     }
 
     #[test]
     fn the_samples_picture_puts_dots_at_the_zoomed_positions() {
-        let s = Sampler::new(SamplerKind::Uniform, 4, 0).unwrap();
-        let f = Film::from_colors(2, 1, s, vec![Vec3::X; 8]).unwrap();
-        let p = f.samples_picture(4).unwrap();
+        let s = Sampler::new(SamplerKind::Uniform, 4, 0).expect("a valid test value");
+        let f = Film::from_colors(2, 1, s, vec![Vec3::X; 8]).expect("a valid test value");
+        let p = f.samples_picture(4).expect("a valid test value");
         assert_eq!((p.width, p.height), (8, 4));
         let at = |x: usize, row: usize| &p.rgb[(row * 8 + x) * 3..(row * 8 + x) * 3 + 3];
         // Dots at x = 1, 3 (pixel 0) and 5, 7 (pixel 1); y = 1, 3 from the bottom.
@@ -402,8 +411,8 @@ mod tests {
 
     #[test]
     fn filters_too_wide_for_their_samples_are_refused() {
-        let s = Sampler::new(SamplerKind::Random, 1024, 0).unwrap();
-        let g = Filter::gaussian(30.0).unwrap();
+        let s = Sampler::new(SamplerKind::Random, 1024, 0).expect("a valid test value");
+        let g = Filter::gaussian(30.0).expect("a valid test value");
         assert!(matches!(
             check_film(256, 256, &s, &g),
             Err(FilmError::FilterTooWide { .. })

@@ -97,7 +97,8 @@ mod tests {
 
     #[test]
     fn supports_hold_every_sample_within_the_radius() {
-        let support = |f: Result<Filter, FilterError>| f.unwrap().support_radius();
+        let support =
+            |f: Result<Filter, FilterError>| f.expect("a valid test value").support_radius();
         assert_eq!(support(Filter::box_filter(0.5)), 0);
         assert_eq!(support(Filter::box_filter(0.51)), 1);
         assert_eq!(support(Filter::tent(1.5)), 1);
@@ -111,14 +112,14 @@ mod tests {
 
     #[test]
     fn weights_follow_the_handout() {
-        let b = Filter::box_filter(0.5).unwrap();
+        let b = Filter::box_filter(0.5).expect("a valid test value");
         assert_eq!(b.weight(0.5, -0.5), 1.0);
         assert_eq!(b.weight(0.51, 0.0), 0.0);
-        let t = Filter::tent(2.0).unwrap();
+        let t = Filter::tent(2.0).expect("a valid test value");
         assert_eq!(t.weight(0.0, 0.0), 1.0);
         assert_eq!(t.weight(1.0, 0.0), 0.5);
         assert_eq!(t.weight(0.0, -3.0), 0.0);
-        let g = Filter::gaussian(0.5).unwrap();
+        let g = Filter::gaussian(0.5).expect("a valid test value");
         assert_eq!(g.weight(0.0, 0.0), 1.0);
         assert!((g.weight(1.0, 0.0) - (-2.0f32).exp()).abs() < 1e-7);
         // Beyond 2σ the weight is small but not cut.

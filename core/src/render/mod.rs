@@ -40,8 +40,8 @@ pub use object_rays::{ObjectRays, ObjectT};
 pub use plan::{Cancel, Cancelled, Passes, RenderPlan, Tracing, Uncancellable};
 pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_frame};
 pub use rule_gap::{NormalGap, normal_rule_gap};
-pub use sampling::{DEFAULT_SEED, Sampler, SamplerError, SamplerKind};
 pub use rules::{Ambient, Rules};
+pub use sampling::{DEFAULT_SEED, Sampler, SamplerError, SamplerKind};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use whitted::{

@@ -157,19 +157,11 @@ impl Sampler {
     /// Position of sample `n` (0-based, below `count`) of the pixel numbered `pixel`, in the
     /// pixel's unit square, each coordinate in [0, 1).
     pub fn position(&self, pixel: u64, n: u32) -> Vec2 {
-        let cell = |n: u32| {
-            Vec2::new(
-                (n % self.side.max(1)) as f32,
-                (n / self.side.max(1)) as f32,
-            )
-        };
+        let cell = |n: u32| Vec2::new((n % self.side.max(1)) as f32, (n / self.side.max(1)) as f32);
         let k = self.side.max(1) as f32;
         match self.kind {
             SamplerKind::Uniform => (cell(n) + Vec2::splat(0.5)) / k,
-            SamplerKind::Random => Vec2::new(
-                self.uniform(pixel, n, 0),
-                self.uniform(pixel, n, 1),
-            ),
+            SamplerKind::Random => Vec2::new(self.uniform(pixel, n, 0), self.uniform(pixel, n, 1)),
             SamplerKind::Jittered => {
                 let u = Vec2::new(self.uniform(pixel, n, 0), self.uniform(pixel, n, 1));
                 // (a + u)/k rounds up to exactly 1 only where u is within an ulp of 1.
@@ -214,12 +206,15 @@ mod tests {
 
     #[test]
     fn uniform_samples_are_the_cell_centres_of_a_k_by_k_grid() {
-        let s = Sampler::new(SamplerKind::Uniform, 4, 1).unwrap();
+        let s = Sampler::new(SamplerKind::Uniform, 4, 1).expect("a valid test value");
         let p = positions(&s, 0);
         for want in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
-            assert!(p.contains(&Vec2::new(want.0, want.1)), "{want:?} not in {p:?}");
+            assert!(
+                p.contains(&Vec2::new(want.0, want.1)),
+                "{want:?} not in {p:?}"
+            );
         }
-        let s = Sampler::new(SamplerKind::Uniform, 9, 1).unwrap();
+        let s = Sampler::new(SamplerKind::Uniform, 9, 1).expect("a valid test value");
         let xs: Vec<f32> = positions(&s, 3).iter().map(|p| p.x).take(3).collect();
         assert_eq!(xs, [1.0 / 6.0, 0.5, 5.0 / 6.0]);
     }
@@ -248,11 +243,14 @@ mod tests {
 
     #[test]
     fn jittered_samples_keep_one_to_each_cell() {
-        let s = Sampler::new(SamplerKind::Jittered, 16, 42).unwrap();
+        let s = Sampler::new(SamplerKind::Jittered, 16, 42).expect("a valid test value");
         for pixel in 0..50 {
             let mut seen = [false; 16];
             for p in positions(&s, pixel) {
-                assert!((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y), "{p}");
+                assert!(
+                    (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y),
+                    "{p}"
+                );
                 let c = (p.y * 4.0) as usize * 4 + (p.x * 4.0) as usize;
                 assert!(!seen[c], "two samples in cell {c} of pixel {pixel}");
                 seen[c] = true;
@@ -262,7 +260,7 @@ mod tests {
 
     #[test]
     fn random_positions_depend_on_seed_pixel_and_sample_and_repeat() {
-        let a = Sampler::new(SamplerKind::Random, 9, 1).unwrap();
+        let a = Sampler::new(SamplerKind::Random, 9, 1).expect("a valid test value");
         let b = a.with_seed(2);
         assert_eq!(positions(&a, 5), positions(&a, 5));
         assert_ne!(positions(&a, 5), positions(&b, 5));
@@ -275,7 +273,7 @@ mod tests {
     fn random_positions_fill_the_pixel_evenly() {
         // 40,000 positions in a 10 × 10 histogram: each bin expects 400 with a standard
         // deviation of about 20; 6 deviations either way would fail a skewed generator.
-        let s = Sampler::new(SamplerKind::Random, 400, DEFAULT_SEED).unwrap();
+        let s = Sampler::new(SamplerKind::Random, 400, DEFAULT_SEED).expect("a valid test value");
         let mut bins = [0u32; 100];
         let mut sum = Vec2::ZERO;
         for pixel in 0..100 {
@@ -286,12 +284,16 @@ mod tests {
         }
         assert!(bins.iter().all(|&b| (280..=520).contains(&b)), "{bins:?}");
         let mean = sum / 40_000.0;
-        assert!((mean - Vec2::splat(0.5)).abs().max_element() < 0.005, "{mean}");
+        assert!(
+            (mean - Vec2::splat(0.5)).abs().max_element() < 0.005,
+            "{mean}"
+        );
     }
 
     #[test]
     fn too_many_samples_in_all_are_refused_without_overflow() {
-        let s = Sampler::new(SamplerKind::Random, MAX_SAMPLES_PER_PIXEL, 0).unwrap();
+        let s = Sampler::new(SamplerKind::Random, MAX_SAMPLES_PER_PIXEL, 0)
+            .expect("a valid test value");
         assert!(s.check_image(1024, 1).is_ok());
         assert!(matches!(
             s.check_image(16384, 16384),
