@@ -338,6 +338,8 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         object_rays: job.object_rays,
         variant: None,
         secondary: job.secondary,
+        // The command line traces and filters its film itself (`supersample.rs`).
+        supersample: None,
     };
     if job.supersample.is_set() {
         // The film is traced where the colour image or the samples' picture needs it.

@@ -60,6 +60,8 @@ pub enum AppCommand {
     ShowRayPanel(bool),
     /// Shadows, bounces, weight and the specular fix of the view (View › Rays).
     SetRays(tracelab_core::render::Secondary),
+    /// The view's sampler and filter (View › Supersampling); `None`: one ray a pixel.
+    SetSupersampling(Option<tracelab_core::render::Supersampling>),
     ResetLayout,
     /// Move the camera to show the selected node whole (F).
     FrameSelected,

@@ -14,6 +14,7 @@ use super::compile::CompiledScene;
 use super::filter::Filter;
 use super::frame::{Frame, Sample, quantize};
 use super::limits::{ImageSizeError, check_image_size};
+use super::plan::{Cancel, Uncancellable};
 use super::progressive::trace_color;
 use super::sampling::{Sampler, SamplerError};
 use crate::memory::{OutOfMemory, try_vec};
@@ -44,6 +45,14 @@ pub enum FilmError {
     },
     #[error(transparent)]
     OutOfMemory(#[from] OutOfMemory),
+}
+
+/// A render's sampler and filter: what the progressive renderer refines toward after its
+/// full-resolution pass (`RenderSettings::supersample`; the editor's View › Supersampling).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Supersampling {
+    pub sampler: Sampler,
+    pub filter: Filter,
 }
 
 /// Every sample of a render: for pixel (i, j) and sample n, its colour at
@@ -127,20 +136,43 @@ impl Film {
         settings: &RenderSettings,
         sampler: Sampler,
     ) -> Result<Film, FilmError> {
+        match Self::render_until(scene, settings, sampler, &Uncancellable) {
+            Ok(film) => film,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Film::render`], stopped between rows when `cancel` says so.
+    pub fn render_until<C: Cancel>(
+        scene: &CompiledScene,
+        settings: &RenderSettings,
+        sampler: Sampler,
+        cancel: &C,
+    ) -> Result<Result<Film, FilmError>, C::Stop> {
         let (w, h) = (settings.width, settings.height);
-        check_image_size(w, h).map_err(|source| FilmError::ImageSize {
-            what: "the image",
-            source,
-        })?;
-        sampler.check_image(w, h)?;
+        if let Err(source) = check_image_size(w, h) {
+            return Ok(Err(FilmError::ImageSize {
+                what: "the image",
+                source,
+            }));
+        }
+        if let Err(e) = sampler.check_image(w, h) {
+            return Ok(Err(e.into()));
+        }
         let n = sampler.count() as usize;
-        let mut colors = try_vec(w as usize * h as usize * n, Vec3::ZERO, "the samples")?;
+        let mut colors = match try_vec(w as usize * h as usize * n, Vec3::ZERO, "the samples") {
+            Ok(c) => c,
+            Err(e) => return Ok(Err(e.into())),
+        };
         let s = w.max(h) as f32;
         let (dx, dy) = ((s - w as f32) * 0.5, (s - h as f32) * 0.5);
         colors
             .par_chunks_mut(w as usize * n)
             .enumerate()
-            .for_each(|(j, row)| {
+            .try_for_each(|(j, row)| {
+                if let Some(stop) = cancel.stop() {
+                    return Err(stop);
+                }
                 let j = j as u32;
                 for (i, px) in row.chunks_mut(n).enumerate() {
                     let i = i as u32;
@@ -154,13 +186,14 @@ impl Film {
                         *c = trace_color(scene, settings, &scene.camera.ray_at(x, y));
                     }
                 }
-            });
-        Ok(Film {
+                Ok(())
+            })?;
+        Ok(Ok(Film {
             width: w,
             height: h,
             sampler,
             colors,
-        })
+        }))
     }
 
     /// A film from given colours (tests): `colors` as [`Film`] orders them.
@@ -236,6 +269,27 @@ impl Film {
                 }
             });
         Ok(frame)
+    }
+
+    /// Writes the filtered colours over `frame`'s (same size), keeping its normals, depths
+    /// and hits: those of the centre rays, which picking and the other views use.
+    pub fn filter_into(&self, filter: &Filter, frame: &mut Frame) -> Result<(), FilmError> {
+        check_film(self.width, self.height, &self.sampler, filter)?;
+        if (frame.width, frame.height) != (self.width, self.height) {
+            return Ok(());
+        }
+        let w = self.width as usize;
+        frame
+            .samples
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(row, out)| {
+                let j = self.height - 1 - row as u32;
+                for (i, s) in out.iter_mut().enumerate() {
+                    s.color = bytes(self.filtered(filter, i as u32, j));
+                }
+            });
+        Ok(())
     }
 
     /// `-render_samples`: each pixel a `zoom` × `zoom` square, grey (0.2) and black as a

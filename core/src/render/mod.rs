@@ -28,7 +28,7 @@ mod whitted;
 
 pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, PointLight, Shape};
-pub use film::{Film, FilmError, Picture, check_film, filter_picture};
+pub use film::{Film, FilmError, Picture, Supersampling, check_film, filter_picture};
 pub use filter::{Filter, FilterError};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use grid_data::{GridScene, RayCounts};
@@ -89,6 +89,9 @@ pub struct RenderSettings {
     pub variant: Option<Variant>,
     /// Shadows, reflection and refraction (assignment 4) and the specular fix (assignment 3).
     pub secondary: Secondary,
+    /// Assignment 7: after its full-resolution pass, a progressive render traces these
+    /// samples and filters them into the colours (`None`: one ray a pixel).
+    pub supersample: Option<Supersampling>,
 }
 
 impl RenderSettings {
@@ -101,6 +104,7 @@ impl RenderSettings {
             object_rays: ObjectRays::Unnormalized,
             variant: None,
             secondary: Secondary::default(),
+            supersample: None,
         }
     }
 }

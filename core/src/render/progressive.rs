@@ -489,6 +489,13 @@ fn render_scales<C: Cancel>(
         .tiles_total
         .store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
     let mut plan = scales.to_vec();
+    // Supersampling refines the full-resolution pass: not made by a coarse-only plan.
+    let supersampled = settings.supersample.is_some() && plan.last() == Some(&1);
+    if supersampled {
+        target
+            .tiles_total
+            .fetch_add(tiles.len() as u64, Ordering::Relaxed);
+    }
     let mut pass = 0;
     while let Some(&scale) = plan.get(pass) {
         let pass_start = Instant::now();
@@ -567,17 +574,57 @@ fn render_scales<C: Cancel>(
         );
         if skip > 0 {
             plan.drain(pass + 1..pass + 1 + skip);
-            target
-                .tiles_total
-                .store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
+            target.tiles_total.store(
+                (tiles.len() * (plan.len() + usize::from(supersampled))) as u64,
+                Ordering::Relaxed,
+            );
         }
         on_pass(PassInfo {
             pass,
-            passes: plan.len(),
+            passes: plan.len() + usize::from(supersampled),
             scale,
             elapsed: start.elapsed(),
         });
         pass += 1;
+    }
+    if let Some(ss) = settings.supersample.filter(|_| supersampled) {
+        supersample_pass(scene, settings, ss, target, cancel)?;
+        target
+            .tiles_done
+            .fetch_add(tiles.len() as u64, Ordering::Relaxed);
+        on_pass(PassInfo {
+            pass,
+            passes: pass + 1,
+            scale: 1,
+            elapsed: start.elapsed(),
+        });
+    }
+    Ok(())
+}
+
+/// The pass after the full-resolution one where the settings ask for supersampling: every
+/// sample traced (cancellably), filtered into the frame's colours. Where the samples or the
+/// filter's work would pass their caps, or do not fit in memory, the one-ray image stays and
+/// a warning says why.
+fn supersample_pass<C: Cancel>(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    ss: super::film::Supersampling,
+    target: &SharedFrame,
+    cancel: &C,
+) -> Result<(), C::Stop> {
+    let (w, h) = (settings.width, settings.height);
+    let film = match super::film::check_film(w, h, &ss.sampler, &ss.filter) {
+        Ok(()) => super::film::Film::render_until(scene, settings, ss.sampler, cancel)?,
+        Err(e) => Err(e),
+    };
+    let done = film.and_then(|film| {
+        let mut f = target.lock();
+        film.filter_into(&ss.filter, &mut f)
+    });
+    match done {
+        Ok(()) => target.bump(),
+        Err(e) => log::warn!("supersampling skipped at {w}x{h}: {e}"),
     }
     Ok(())
 }

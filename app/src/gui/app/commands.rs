@@ -105,6 +105,7 @@ impl TracelabApp {
             AppCommand::ShowPixelInspector(open) => self.pixel_inspector_open = open,
             AppCommand::ShowRayPanel(open) => self.ray_panel_open = open,
             AppCommand::SetRays(rays) => self.view.secondary = rays,
+            AppCommand::SetSupersampling(ss) => self.view.supersample = ss,
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {
                 Some(Selection::Node(id)) => self.frame_node(id),

@@ -50,6 +50,8 @@ pub struct ViewSettings {
     pub overlays: bool,
     /// Shadows, bounces, weight and the specular fix (View › Rays); the course's defaults.
     pub secondary: Secondary,
+    /// Assignment 7's sampler and filter (View › Supersampling); `None`: one ray a pixel.
+    pub supersample: Option<tracelab_core::render::Supersampling>,
 }
 
 impl Default for ViewSettings {
@@ -66,6 +68,7 @@ impl Default for ViewSettings {
             gizmo_axes: Axes::World,
             overlays: true,
             secondary: Secondary::default(),
+            supersample: None,
         }
     }
 }
@@ -617,6 +620,7 @@ impl Viewport {
             object_rays: s.object_rays,
             variant: None,
             secondary: s.secondary,
+            supersample: s.supersample,
         }
     }
 }
