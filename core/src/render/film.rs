@@ -9,14 +9,17 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use thiserror::Error;
 
+use super::ObjectRays;
 use super::RenderSettings;
 use super::compile::CompiledScene;
 use super::filter::Filter;
 use super::frame::{Frame, Sample, quantize};
 use super::limits::{ImageSizeError, check_image_size};
 use super::plan::{Cancel, Uncancellable};
-use super::progressive::trace_color;
 use super::sampling::{Sampler, SamplerError};
+use super::shade::shade_fast;
+use super::whitted::{needs_whitted, shade_primary};
+use crate::geometry::Ray;
 use crate::memory::{OutOfMemory, try_vec};
 
 /// Most weights one filtered image may evaluate (pixels × samples a pixel × pixels in the
@@ -94,6 +97,21 @@ impl Picture {
 
 fn bytes(c: Vec3) -> [u8; 3] {
     [quantize(c.x), quantize(c.y), quantize(c.z)]
+}
+
+/// The colour one ray brings back, before quantisation (the background for a miss): what a
+/// supersampled render averages.
+fn trace_color(scene: &CompiledScene, s: &RenderSettings, ray: &Ray) -> glam::Vec3 {
+    let hit = if s.object_rays == ObjectRays::Unnormalized {
+        scene.intersect(ray, scene.camera.t_min(), f32::INFINITY)
+    } else {
+        scene.intersect_with(ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
+    };
+    match hit {
+        None => scene.background,
+        Some(h) if needs_whitted(scene, s) => shade_primary(scene, ray, &h, s).0,
+        Some(h) => shade_fast(scene, ray, &h, s).0,
+    }
 }
 
 /// The pixel number the sampler is given for pixel (i, j): the same in every render of one
@@ -317,6 +335,26 @@ impl Film {
         }
         Ok(pic)
     }
+}
+
+/// The film of the progressive renderer's pass after its full-resolution one, where the
+/// settings ask for supersampling, traced cancellably; `None` (and a warning saying why)
+/// where the samples or the filter's work would pass their caps or do not fit in memory:
+/// the one-ray image then stays.
+pub(super) fn supersample_film<C: Cancel>(
+    scene: &CompiledScene,
+    settings: &RenderSettings,
+    ss: Supersampling,
+    cancel: &C,
+) -> Result<Option<Film>, C::Stop> {
+    let (w, h) = (settings.width, settings.height);
+    let film = match check_film(w, h, &ss.sampler, &ss.filter) {
+        Ok(()) => Film::render_until(scene, settings, ss.sampler, cancel)?,
+        Err(e) => Err(e),
+    };
+    Ok(film
+        .map_err(|e| log::warn!("supersampling skipped at {w}x{h}: {e}"))
+        .ok())
 }
 
 /// The size of `-render_samples`' picture, checked against the image caps.

@@ -119,21 +119,6 @@ fn trace_sample(scene: &CompiledScene, s: &RenderSettings, ray: Ray, dst: &mut S
     store_sample(scene, dst, hit.as_ref(), shaded);
 }
 
-/// The colour one ray brings back, before quantisation (the background for a miss): what a
-/// supersampled render averages.
-pub(super) fn trace_color(scene: &CompiledScene, s: &RenderSettings, ray: &Ray) -> glam::Vec3 {
-    let hit = if s.object_rays == ObjectRays::Unnormalized {
-        scene.intersect(ray, scene.camera.t_min(), f32::INFINITY)
-    } else {
-        scene.intersect_with(ray, scene.camera.t_min(), f32::INFINITY, s.object_rays)
-    };
-    match hit {
-        None => scene.background,
-        Some(h) if needs_whitted(scene, s) => shade_primary(scene, ray, &h, s).0,
-        Some(h) => shade_fast(scene, ray, &h, s).0,
-    }
-}
-
 /// Traces the grid points `pts` (grid coordinates of one tile's pass, in the order
 /// `points_to_trace` gives them: 4×2 neighbourhoods) eight rays at a time, storing each sample
 /// at its place in `grid` (row-major, `gw` points a row).
@@ -588,7 +573,13 @@ fn render_scales<C: Cancel>(
         pass += 1;
     }
     if let Some(ss) = settings.supersample.filter(|_| supersampled) {
-        supersample_pass(scene, settings, ss, target, cancel)?;
+        // Traced with the frame unlocked; filtered into it under the lock.
+        if let Some(film) = super::film::supersample_film(scene, settings, ss, cancel)? {
+            match film.filter_into(&ss.filter, &mut target.lock()) {
+                Ok(()) => target.bump(),
+                Err(e) => log::warn!("supersampling skipped: {e}"),
+            }
+        }
         target
             .tiles_done
             .fetch_add(tiles.len() as u64, Ordering::Relaxed);
@@ -598,33 +589,6 @@ fn render_scales<C: Cancel>(
             scale: 1,
             elapsed: start.elapsed(),
         });
-    }
-    Ok(())
-}
-
-/// The pass after the full-resolution one where the settings ask for supersampling: every
-/// sample traced (cancellably), filtered into the frame's colours. Where the samples or the
-/// filter's work would pass their caps, or do not fit in memory, the one-ray image stays and
-/// a warning says why.
-fn supersample_pass<C: Cancel>(
-    scene: &CompiledScene,
-    settings: &RenderSettings,
-    ss: super::film::Supersampling,
-    target: &SharedFrame,
-    cancel: &C,
-) -> Result<(), C::Stop> {
-    let (w, h) = (settings.width, settings.height);
-    let film = match super::film::check_film(w, h, &ss.sampler, &ss.filter) {
-        Ok(()) => super::film::Film::render_until(scene, settings, ss.sampler, cancel)?,
-        Err(e) => Err(e),
-    };
-    let done = film.and_then(|film| {
-        let mut f = target.lock();
-        film.filter_into(&ss.filter, &mut f)
-    });
-    match done {
-        Ok(()) => target.bump(),
-        Err(e) => log::warn!("supersampling skipped at {w}x{h}: {e}"),
     }
     Ok(())
 }
