@@ -88,8 +88,11 @@ type MakeFilter = fn(f32) -> Result<Filter, FilterError>;
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SamplerMode {
+    /// A k×k grid of cell centres, (a + ½)/k (the course's -uniform_samples).
     Uniform,
+    /// Anywhere in the pixel, seeded (-random_samples).
     Random,
+    /// One anywhere in each cell of a k×k grid, seeded (-jittered_samples).
     Jittered,
 }
 
