@@ -153,6 +153,9 @@ struct Planned {
 fn plan_line(line: CourseLine, images: &Path, scenes: &Path) -> Planned {
     let job = (|| {
         let mut job = parse_course_args(&line.args).map_err(|e| e.to_string())?;
+        job.supersample
+            .refuse_pictures("diff --batch")
+            .map_err(|e| e.to_string())?;
         check_size(job.width, job.height).map_err(|e| e.to_string())?;
         let scene = job.scene.take().unwrap_or_default();
         job.scene = Some(inside(scenes, &scene, "-input")?);

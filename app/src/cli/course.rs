@@ -3,33 +3,24 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use tracelab_core::render::Secondary;
+use tracelab_core::render::{Filter, SamplerKind, Secondary};
 use tracelab_core::{NormalTransform, ObjectRays};
 
 use super::render::RenderJob;
+use super::supersample::Supersample;
 use super::values::{parse_count, parse_f32, parse_u32};
 use crate::exit::usage;
 use crate::io::write_stderr_text;
-
-/// Flags of the course's later weeks that tracelab does not implement yet: refused by name,
-/// never ignored (an image made without them would be silently wrong).
-const NOT_YET: [(&str, &str); 8] = [
-    ("-random_samples", "assignment 7's sampling"),
-    ("-uniform_samples", "assignment 7's sampling"),
-    ("-jittered_samples", "assignment 7's sampling"),
-    ("-box_filter", "assignment 7's filters"),
-    ("-tent_filter", "assignment 7's filters"),
-    ("-gaussian_filter", "assignment 7's filters"),
-    ("-render_samples", "assignment 7's sample view"),
-    ("-render_filter", "assignment 7's filter view"),
-];
 
 /// The course's flags, verbatim: `-input F -size W H -output F -normals F -depth MIN MAX F
 /// -shade_back` (assignments 1–2), `-shadows -bounces N -weight W` (assignment 4), the
 /// OpenGL preview's `-gui -tessellation A B -gouraud` (accepted, with a note: the editor is
 /// tracelab's preview), plus tracelab's `-specular_fix` (assignment 3's optional fix),
-/// `-normal_transform correct|incorrect` and
-/// `-object_rays unnormalized|normalized|normalized-no-rescale`.
+/// `-normal_transform correct|incorrect`,
+/// `-object_rays unnormalized|normalized|normalized-no-rescale`, and assignment 7's sampling
+/// (`-uniform_samples`, `-random_samples`, `-jittered_samples`, `-box_filter`, `-tent_filter`,
+/// `-gaussian_filter`, `-render_samples FILE ZOOM`, `-render_filter FILE ZOOM`) with
+/// tracelab's `-seed N` for the random ones.
 pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
     let mut job = RenderJob {
         scene: None,
@@ -45,6 +36,7 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
         grid: None,
         visualize_grid: false,
         stats: false,
+        supersample: Supersample::default(),
     };
     let mut preview = Vec::new();
     let mut it = args.iter();
@@ -93,12 +85,43 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
                 let ph = parse_u32(&take(&mut it, a)?, "-tessellation phi steps")?;
                 preview.push(format!("-tessellation {th} {ph}"));
             }
-            _ if NOT_YET.iter().any(|(f, _)| *f == a) => {
-                let what = NOT_YET.iter().find(|(f, _)| *f == a).map_or("", |(_, w)| w);
-                return Err(usage(format!(
-                    "{a} ({what}) is not implemented by tracelab yet; \
-                     an image rendered without it would not be the course's"
-                )));
+            "-uniform_samples" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_sampler(SamplerKind::Uniform, &v, a)?;
+            }
+            "-random_samples" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_sampler(SamplerKind::Random, &v, a)?;
+            }
+            "-jittered_samples" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_sampler(SamplerKind::Jittered, &v, a)?;
+            }
+            "-box_filter" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_filter(Filter::box_filter, &v, a)?;
+            }
+            "-tent_filter" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_filter(Filter::tent, &v, a)?;
+            }
+            "-gaussian_filter" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_filter(Filter::gaussian, &v, a)?;
+            }
+            "-seed" => {
+                let v = take(&mut it, a)?;
+                job.supersample.set_seed(&v, a)?;
+            }
+            "-render_samples" | "-render_filter" => {
+                let file = take(&mut it, a)?;
+                let zoom = take(&mut it, &format!("{a} FILE"))?;
+                let picture = Supersample::picture(&file, &zoom, a)?;
+                if a == "-render_samples" {
+                    job.supersample.render_samples = Some(picture);
+                } else {
+                    job.supersample.render_filter = Some(picture);
+                }
             }
             "-normal_transform" => {
                 let v = take(&mut it, a)?;
@@ -124,7 +147,7 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
             }
             _ => {
                 return Err(usage(format!(
-                    "unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back -shadows -bounces -weight)",
+                    "unknown option \"{}\" (course flags: -input -size -output -normals -depth -shade_back -shadows -bounces -weight -grid -visualize_grid -stats -uniform_samples -random_samples -jittered_samples -box_filter -tent_filter -gaussian_filter -render_samples -render_filter -seed)",
                     arg.display()
                 )));
             }
@@ -144,6 +167,22 @@ pub fn parse_course_args(args: &[OsString]) -> anyhow::Result<RenderJob> {
             "-visualize_grid shows the grid -grid NX NY NZ builds: give -grid too",
         ));
     }
+    let mut others: Vec<&str> = Vec::new();
+    if job.normals.is_some() {
+        others.push("-normals");
+    }
+    if job.depth.is_some() {
+        others.push("-depth");
+    }
+    if job.visualize_grid {
+        others.push("-visualize_grid");
+    }
+    job.supersample.resolve(
+        job.width,
+        job.height,
+        &others,
+        job.stats.then_some("-stats"),
+    )?;
     if !preview.is_empty() {
         write_stderr_text(&format!(
             "tracelab: note: {} only set the course's OpenGL preview, which tracelab does not \

@@ -370,8 +370,13 @@ pub(super) fn judge_line<'s>(
         .collect::<anyhow::Result<Vec<_>>>()?;
     let decoded: Vec<&Decoded> = verdicts.iter().filter_map(|v| v.decoded.as_ref()).collect();
     let mut diagnosis = String::new();
-    // The catalogue's mistakes are of the render, not of a picture of the grid's cells.
-    if !verdicts.iter().all(|v| v.ok) && !decoded.is_empty() && !job.visualize_grid {
+    // The catalogue's mistakes are of the one-ray-a-pixel render, not of a picture of the
+    // grid's cells nor of a supersampled image (its variants would not be supersampled).
+    if !verdicts.iter().all(|v| v.ok)
+        && !decoded.is_empty()
+        && !job.visualize_grid
+        && !job.supersample.filters_the_output()
+    {
         // The mistake first: it says more than any pixel.
         let judged: Vec<Judged> = decoded
             .iter()
@@ -557,6 +562,7 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
         ));
     }
     let job: RenderJob = parse_course_args(&a.course)?;
+    job.supersample.refuse_pictures("diff")?;
     check_size(job.width, job.height)?;
     let size = (job.width, job.height);
     // Heat maps are invented names: never a file this command reads or the line names.

@@ -19,6 +19,7 @@ mod regions;
 mod render;
 mod report_html;
 mod stats;
+mod supersample;
 mod values;
 
 use std::borrow::Cow;
@@ -47,7 +48,14 @@ use crate::io::{write_stderr_text, write_stdout};
         tracelab -input scene2_05_inside_sphere.txt -size 200 200 -output out.tga \\\n    \
         -depth 9 11 depth.tga -normals normals.tga -shade_back\n  \
         tracelab -input scene4_14_faceted_gem.txt -size 200 200 -output out.png \\\n    \
-        -shadows -shade_back -bounces 5 -weight 0.01\n\n\
+        -shadows -shade_back -bounces 5 -weight 0.01\n  \
+        tracelab -input scene7_02_checkerboard.txt -size 180 180 -output out.png \\\n    \
+        -jittered_samples 16 -gaussian_filter 0.6 -seed 1\n\n\
+        Assignment 7: -uniform_samples N and -jittered_samples N take a square N (k x k), \
+        -random_samples N any N (1 to 65536); -box_filter R, -tent_filter R (0 < R <= 64), \
+        -gaussian_filter SIGMA (<= 32); -render_samples FILE ZOOM, -render_filter FILE ZOOM. \
+        Random and jittered sampling are repeatable: tracelab's -seed N (0 to 2^64-1, \
+        default 6837) picks the positions.\n\n\
         Images are at most 16384 pixels a side and 67108864 (8192x8192) pixels in all.",
     args_conflicts_with_subcommands = true
 )]

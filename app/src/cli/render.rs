@@ -8,10 +8,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use clap::ValueEnum;
-use tracelab_core::render::{RenderPlan, Secondary, SharedFrame, Uncancellable, render};
+use tracelab_core::render::{
+    Filter, FilterError, RenderPlan, SamplerKind, Secondary, SharedFrame, Uncancellable, render,
+};
 use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
 use super::progress::Progress;
+use super::supersample::{Supersample, film_error, film_for, write_pictures};
 use super::values::parse_f32;
 use crate::exit::{check_size, usage};
 use crate::io::{OutputError, OutputPlan, load_scene_and_meshes};
@@ -43,6 +46,98 @@ pub struct RenderArgs {
     pub object_rays: ObjectRaysMode,
     #[command(flatten)]
     pub secondary: SecondaryArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+}
+
+/// Assignment 7's flags (the course's -uniform_samples, -box_filter, ... spelled long).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SamplingArgs {
+    /// Samples a pixel (1 to 65536; a square for uniform and jittered sampling; at most
+    /// 67,108,864 samples in the image). Default: one sample at the pixel's centre.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<OsString>,
+    /// Where the samples lie in the pixel: a k×k grid of cell centres, anywhere (random), or
+    /// one anywhere in each cell of a k×k grid (jittered). Needs --samples.
+    #[arg(long, value_enum, requires = "samples")]
+    pub sampler: Option<SamplerMode>,
+    /// Box filter of half-width R pixels (0 < R ≤ 64): the course's -box_filter.
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub box_filter: Option<OsString>,
+    /// Tent filter of radius R pixels (0 < R ≤ 64): the course's -tent_filter.
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub tent_filter: Option<OsString>,
+    /// Gaussian filter e^(−d²/2σ²) over 2σ pixels (0 < σ ≤ 32): the course's -gaussian_filter.
+    #[arg(long, value_name = "SIGMA", allow_negative_numbers = true)]
+    pub gaussian_filter: Option<OsString>,
+    /// Seed of random and jittered sampling (0 to 2^64−1; default 6837): the same seed gives
+    /// the same image. The course's lines take -seed N.
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub seed: Option<OsString>,
+    /// The samples as dots of their colour, each pixel ZOOM×ZOOM: the course's -render_samples.
+    #[arg(long, num_args = 2, value_names = ["FILE", "ZOOM"], allow_negative_numbers = true)]
+    pub render_samples: Option<Vec<OsString>>,
+    /// The filter's weights around the centre pixel, each pixel ZOOM×ZOOM: the course's
+    /// -render_filter.
+    #[arg(long, num_args = 2, value_names = ["FILE", "ZOOM"], allow_negative_numbers = true)]
+    pub render_filter: Option<Vec<OsString>>,
+}
+
+/// A filter from its one number, checked (`Filter::box_filter`, `tent`, `gaussian`).
+type MakeFilter = fn(f32) -> Result<Filter, FilterError>;
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerMode {
+    /// A k×k grid of cell centres, (a + ½)/k (the course's -uniform_samples).
+    Uniform,
+    /// Anywhere in the pixel, seeded (-random_samples).
+    Random,
+    /// One anywhere in each cell of a k×k grid, seeded (-jittered_samples).
+    Jittered,
+}
+
+impl SamplingArgs {
+    /// The flags checked one by one, as the course's are.
+    pub fn supersample(&self) -> anyhow::Result<Supersample> {
+        let mut s = Supersample::default();
+        if let Some(n) = &self.samples {
+            let kind = match self.sampler.unwrap_or(SamplerMode::Uniform) {
+                SamplerMode::Uniform => SamplerKind::Uniform,
+                SamplerMode::Random => SamplerKind::Random,
+                SamplerMode::Jittered => SamplerKind::Jittered,
+            };
+            s.set_sampler(kind, n, "--samples")?;
+        }
+        let filters: [(&Option<OsString>, &str, MakeFilter); 3] = [
+            (&self.box_filter, "--box-filter", Filter::box_filter),
+            (&self.tent_filter, "--tent-filter", Filter::tent),
+            (&self.gaussian_filter, "--gaussian-filter", Filter::gaussian),
+        ];
+        for (v, flag, make) in filters {
+            if let Some(v) = v {
+                s.set_filter(make, v, flag)?;
+            }
+        }
+        if let Some(v) = &self.seed {
+            s.set_seed(v, "--seed")?;
+        }
+        for (v, flag) in [
+            (&self.render_samples, "--render-samples"),
+            (&self.render_filter, "--render-filter"),
+        ] {
+            let Some(v) = v else { continue };
+            let [file, zoom] = v.as_slice() else {
+                return Err(usage(format!("{flag} needs FILE ZOOM")));
+            };
+            let picture = Supersample::picture(file, zoom, flag)?;
+            if flag == "--render-samples" {
+                s.render_samples = Some(picture);
+            } else {
+                s.render_filter = Some(picture);
+            }
+        }
+        Ok(s)
+    }
 }
 
 /// Assignments 3–4's flags, shared by `render` and `inspect`.
@@ -133,6 +228,8 @@ pub struct RenderJob {
     pub grid: Option<[u32; 3]>,
     pub visualize_grid: bool,
     pub stats: bool,
+    /// Assignment 7: the sampler, the filter, the seed and the pictures of them.
+    pub supersample: Supersample,
 }
 
 pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
@@ -150,6 +247,7 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
         }
     };
     let secondary = r.secondary.secondary()?;
+    let supersample = r.sampling.supersample()?;
     let job = RenderJob {
         scene: r.scene,
         width: r.size.first().copied().unwrap_or(0),
@@ -164,12 +262,26 @@ pub(super) fn render_job(r: RenderArgs) -> anyhow::Result<RenderJob> {
         grid: None,
         visualize_grid: false,
         stats: false,
+        supersample,
     };
-    if job.output.is_none() && job.normals.is_none() && job.depth.is_none() {
+    if job.output.is_none()
+        && job.normals.is_none()
+        && job.depth.is_none()
+        && job.supersample.outputs().next().is_none()
+    {
         return Err(usage(
-            "nothing to write: give --output, --normals or --depth",
+            "nothing to write: give --output, --normals, --depth, --render-samples or --render-filter",
         ));
     }
+    let mut others = Vec::new();
+    if job.normals.is_some() {
+        others.push("--normals");
+    }
+    if job.depth.is_some() {
+        others.push("--depth");
+    }
+    job.supersample
+        .resolve(job.width, job.height, &others, None)?;
     Ok(job)
 }
 
@@ -191,7 +303,9 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         [&job.output, &job.normals]
             .into_iter()
             .flatten()
-            .chain(job.depth.as_ref().map(|d| &d.2))
+            .map(PathBuf::as_path)
+            .chain(job.depth.as_ref().map(|d| d.2.as_path()))
+            .chain(job.supersample.outputs())
     };
     for p in outputs() {
         check_extension(p)?;
@@ -199,6 +313,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
     // Before loading, and long before allocating the frame.
     check_size(job.width, job.height)?;
     check_memory(job.width, job.height)?;
+    let resolved = job.supersample.resolve(job.width, job.height, &[], None)?;
     // Outputs against the scene, each other and their folders before anything is read, then
     // against the meshes the scene turned out to read, before the render.
     let mut plan = OutputPlan::new();
@@ -226,7 +341,32 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         object_rays: job.object_rays,
         variant: None,
         secondary: job.secondary,
+        // The command line traces and filters its film itself (`supersample.rs`).
+        supersample: None,
     };
+    if job.supersample.is_set() {
+        // The film is traced where the colour image or the samples' picture needs it.
+        let film = (job.output.is_some() && job.supersample.filters_the_output()
+            || job.supersample.render_samples.is_some())
+        .then(|| film_for(&compiled, &settings, &resolved))
+        .transpose()?;
+        if let Some(p) = &job.output {
+            let frame = match &film {
+                Some(f) if job.supersample.filters_the_output() => {
+                    f.frame(&resolved.filter).map_err(film_error)?
+                }
+                _ => render_with_progress(&compiled, &settings)?,
+            };
+            crate::io::write_image(&frame, View::Color, (0.0, 1.0), p)
+                .map_err(anyhow::Error::msg)?;
+        }
+        return write_pictures(
+            &job.supersample,
+            &resolved,
+            film.as_ref(),
+            (job.width, job.height),
+        );
+    }
     let frame = frame_for(job, &compiled, &settings)?;
     if job.stats {
         crate::io::write_stdout_text(&super::stats::stats_text(
@@ -272,6 +412,14 @@ pub(super) fn frame_for(
     compiled: &CompiledScene,
     settings: &RenderSettings,
 ) -> anyhow::Result<tracelab_core::Frame> {
+    if job.supersample.filters_the_output() {
+        let resolved = job
+            .supersample
+            .resolve(settings.width, settings.height, &[], None)?;
+        return film_for(compiled, settings, &resolved)?
+            .frame(&resolved.filter)
+            .map_err(film_error);
+    }
     if job.visualize_grid {
         return Ok(tracelab_core::render::visualize_grid(
             compiled,

@@ -65,6 +65,8 @@ pub enum AppCommand {
     SetRays(tracelab_core::render::Secondary),
     /// Render through the course's uniform grid, or show it (View › Uniform grid).
     SetGrid(crate::gui::grid_view::GridSettings),
+    /// The view's sampler and filter (View › Supersampling); `None`: one ray a pixel.
+    SetSupersampling(Option<tracelab_core::render::Supersampling>),
     ResetLayout,
     /// Move the camera to show the selected node whole (F).
     FrameSelected,

@@ -358,6 +358,42 @@ fn course_groups(rng: &mut Rng, ctx: &Ctx, for_diff: bool) -> Vec<Group> {
         }
         g.push(group(v));
     }
+    // Assignment 7: a sampler (uniform and jittered need a square count, at most 65,536 a
+    // pixel), a filter (0 < R ≤ 64, σ ≤ 32), tracelab's seed (only with random or jittered
+    // sampling) and the two pictures, whose files are outputs and whose zoom is capped by the
+    // image size.
+    if rng.one_in(4) {
+        let flag = rng.word("-uniform_samples|-random_samples|-jittered_samples");
+        let v = ctx.pick(
+            rng,
+            "1|4|9|16",
+            "0|-1|2|8|65537|65536|4294967296|1e3|nan|x|4.0|",
+        );
+        g.push(group(vec![plain(flag), plain(v)]));
+    }
+    if rng.one_in(4) {
+        let flag = rng.word("-box_filter|-tent_filter|-gaussian_filter");
+        let v = ctx.pick(rng, "0.5|1|1.7|2.3", "0|-0|-1|nan|inf|-inf|1e39|64.5|33|x|");
+        g.push(group(vec![plain(flag), plain(v)]));
+    }
+    if rng.one_in(8) {
+        let v = ctx.pick(
+            rng,
+            "0|1|18446744073709551615",
+            "-1|18446744073709551616|1e3|x|",
+        );
+        g.push(group(vec![plain("-seed"), plain(v)]));
+    }
+    for flag in ["-render_samples", "-render_filter"] {
+        if rng.one_in(8) {
+            let zoom = ctx.pick(rng, "1|4|20", "0|-1|100000|4294967296|nan|x|");
+            g.push(group(vec![
+                plain(flag),
+                named(image(rng), out_role),
+                plain(zoom),
+            ]));
+        }
+    }
     if ctx.hostile(rng) && rng.one_in(3) {
         let flag = rng.word(
             "-bogus|-size2|-Input|-|--input|-jitter|-output=x.png|-grid|-stats|-visualize_grid|\
@@ -425,6 +461,34 @@ fn render_groups(rng: &mut Rng, ctx: &Ctx) -> Vec<Group> {
             "x|normalized_no_rescale",
         );
         g.push(group(vec![plain("--object-rays"), plain(v)]));
+    }
+    // Assignment 7, spelled long.
+    if rng.one_in(4) {
+        let v = ctx.pick(rng, "1|4|9|16", "0|-1|8|65537|4294967296|nan|x|");
+        g.push(group(vec![plain("--samples"), plain(v)]));
+        if rng.one_in(2) {
+            let k = ctx.pick(rng, "uniform|random|jittered", "Random|x|");
+            g.push(group(vec![plain("--sampler"), plain(k)]));
+        }
+    }
+    if rng.one_in(4) {
+        let flag = rng.word("--box-filter|--tent-filter|--gaussian-filter");
+        let v = ctx.pick(rng, "0.5|1.5|0.6", "0|-1|nan|inf|1e39|65|x|");
+        g.push(group(vec![plain(flag), plain(v)]));
+    }
+    if rng.one_in(8) {
+        let v = ctx.pick(rng, "0|7", "-1|18446744073709551616|x|");
+        g.push(group(vec![plain("--seed"), plain(v)]));
+    }
+    for flag in ["--render-samples", "--render-filter"] {
+        if rng.one_in(8) {
+            let zoom = ctx.pick(rng, "1|4|20", "0|-1|100000|4294967296|x|");
+            g.push(group(vec![
+                plain(flag),
+                named(image_out_path(rng, ctx), Role::Output),
+                plain(zoom),
+            ]));
+        }
     }
     g
 }

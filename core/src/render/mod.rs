@@ -5,6 +5,8 @@ mod camera;
 mod compile;
 pub mod csg;
 mod cull;
+pub mod film;
+pub mod filter;
 mod frame;
 mod grid_data;
 mod grid_scene;
@@ -17,6 +19,7 @@ mod plan;
 mod progressive;
 mod rule_gap;
 mod rules;
+pub mod sampling;
 mod shade;
 mod shade_lanes;
 mod similitude;
@@ -25,6 +28,8 @@ mod whitted;
 
 pub use camera::CameraRays;
 pub use compile::{CompiledScene, Hit, Object, PointLight, Shape};
+pub use film::{Film, FilmError, Picture, Supersampling, check_film, filter_picture};
+pub use filter::{Filter, FilterError};
 pub use frame::{Frame, Sample, View, depth_shade, quantize};
 pub use grid_data::{GridScene, RayCounts};
 pub use grid_scene::{GridError, GridWalk, grid_cell_color, visualize_grid};
@@ -36,6 +41,7 @@ pub use plan::{Cancel, Cancelled, Passes, RenderPlan, Tracing, Uncancellable};
 pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_frame};
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use rules::{Ambient, Rules};
+pub use sampling::{DEFAULT_SEED, Sampler, SamplerError, SamplerKind};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use whitted::{
@@ -83,6 +89,9 @@ pub struct RenderSettings {
     pub variant: Option<Variant>,
     /// Shadows, reflection and refraction (assignment 4) and the specular fix (assignment 3).
     pub secondary: Secondary,
+    /// Assignment 7: after its full-resolution pass, a progressive render traces these
+    /// samples and filters them into the colours (`None`: one ray a pixel).
+    pub supersample: Option<Supersampling>,
 }
 
 impl RenderSettings {
@@ -95,6 +104,7 @@ impl RenderSettings {
             object_rays: ObjectRays::Unnormalized,
             variant: None,
             secondary: Secondary::default(),
+            supersample: None,
         }
     }
 }

@@ -480,6 +480,13 @@ fn render_scales<C: Cancel>(
         .tiles_total
         .store((tiles.len() * scales.len()) as u64, Ordering::Relaxed);
     let mut plan = scales.to_vec();
+    // Supersampling refines the full-resolution pass: not made by a coarse-only plan.
+    let supersampled = settings.supersample.is_some() && plan.last() == Some(&1);
+    if supersampled {
+        target
+            .tiles_total
+            .fetch_add(tiles.len() as u64, Ordering::Relaxed);
+    }
     let mut pass = 0;
     while let Some(&scale) = plan.get(pass) {
         let pass_start = Instant::now();
@@ -558,17 +565,36 @@ fn render_scales<C: Cancel>(
         );
         if skip > 0 {
             plan.drain(pass + 1..pass + 1 + skip);
-            target
-                .tiles_total
-                .store((tiles.len() * plan.len()) as u64, Ordering::Relaxed);
+            target.tiles_total.store(
+                (tiles.len() * (plan.len() + usize::from(supersampled))) as u64,
+                Ordering::Relaxed,
+            );
         }
         on_pass(PassInfo {
             pass,
-            passes: plan.len(),
+            passes: plan.len() + usize::from(supersampled),
             scale,
             elapsed: start.elapsed(),
         });
         pass += 1;
+    }
+    if let Some(ss) = settings.supersample.filter(|_| supersampled) {
+        // Traced with the frame unlocked; filtered into it under the lock.
+        if let Some(film) = super::film::supersample_film(scene, settings, ss, cancel)? {
+            match film.filter_into(&ss.filter, &mut target.lock()) {
+                Ok(()) => target.bump(),
+                Err(e) => log::warn!("supersampling skipped: {e}"),
+            }
+        }
+        target
+            .tiles_done
+            .fetch_add(tiles.len() as u64, Ordering::Relaxed);
+        on_pass(PassInfo {
+            pass,
+            passes: pass + 1,
+            scale: 1,
+            elapsed: start.elapsed(),
+        });
     }
     Ok(())
 }

@@ -107,6 +107,7 @@ impl TracelabApp {
             AppCommand::RayDiagramsInWindow(w) => self.ray_window = w,
             AppCommand::SetRays(rays) => self.view.secondary = rays,
             AppCommand::SetGrid(grid) => self.grid = grid,
+            AppCommand::SetSupersampling(ss) => self.view.supersample = ss,
             AppCommand::ResetLayout => self.layout.reset(),
             AppCommand::FrameSelected => match self.doc.selection {
                 Some(Selection::Node(id)) => self.frame_node(id),

@@ -150,7 +150,7 @@ impl TracelabApp {
             let keep_open = egui::containers::menu::MenuConfig::new()
                 .close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside);
             egui::containers::menu::SubMenuButton::new("Rays (assignments 3–4)")
-                .config(keep_open)
+                .config(keep_open.clone())
                 .ui(ui, |ui| {
                     let mut rays = self.view.secondary;
                     rays_menu(ui, &mut rays);
@@ -159,15 +159,20 @@ impl TracelabApp {
                     }
                 });
             egui::containers::menu::SubMenuButton::new("Uniform grid (assignments 5–6)")
-                .config(
-                    egui::containers::menu::MenuConfig::new()
-                        .close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside),
-                )
+                .config(keep_open.clone())
                 .ui(ui, |ui| {
                     let mut grid = self.grid;
                     grid_view::menu(ui, &mut grid);
                     if grid != self.grid {
                         out.push(AppCommand::SetGrid(grid));
+                    }
+                });
+            egui::containers::menu::SubMenuButton::new("Supersampling (assignment 7)")
+                .config(keep_open)
+                .ui(ui, |ui| {
+                    let ss = supersampling_menu(ui, self.view.supersample);
+                    if ss != self.view.supersample {
+                        out.push(AppCommand::SetSupersampling(ss));
                     }
                 });
         });
@@ -505,4 +510,62 @@ fn rays_menu(ui: &mut egui::Ui, s: &mut tracelab_core::render::Secondary) {
 
 fn ms_since(a: Instant, b: Instant) -> f64 {
     b.saturating_duration_since(a).as_secs_f64() * 1e3
+}
+
+/// View › Supersampling: samples a pixel, where they lie and the filter, as the course's
+/// flags set them; the render refines toward it after its one-ray pass. The seed is the
+/// command line's default, so the editor shows what `tracelab -input … -jittered_samples 9`
+/// writes.
+fn supersampling_menu(
+    ui: &mut egui::Ui,
+    current: Option<tracelab_core::render::Supersampling>,
+) -> Option<tracelab_core::render::Supersampling> {
+    use tracelab_core::render::{DEFAULT_SEED, Filter, Sampler, SamplerKind, Supersampling};
+    let (mut kind, mut count, mut filter) = current
+        .map_or((SamplerKind::Jittered, 1, Filter::default()), |s| {
+            (s.sampler.kind(), s.sampler.count(), s.filter)
+        });
+    ui.label("Samples a pixel");
+    for n in [1u32, 4, 9, 16, 36] {
+        let text = if n == 1 {
+            "1 (one ray, at the pixel's centre)".to_string()
+        } else {
+            format!("{n}")
+        };
+        ui.radio_value(&mut count, n, text);
+    }
+    ui.separator();
+    ui.label("Where they lie");
+    for (k, text) in [
+        (SamplerKind::Uniform, "Uniform grid (-uniform_samples)"),
+        (SamplerKind::Random, "Random (-random_samples)"),
+        (SamplerKind::Jittered, "Jittered (-jittered_samples)"),
+    ] {
+        ui.radio_value(&mut kind, k, text);
+    }
+    ui.separator();
+    ui.label("Filter");
+    let filters = [
+        (Filter::default(), "Box 0.5: each pixel its own samples"),
+        (Filter::Box { radius: 1.0 }, "Box 1 (-box_filter 1)"),
+        (Filter::Tent { radius: 1.5 }, "Tent 1.5 (-tent_filter 1.5)"),
+        (
+            Filter::Gaussian { sigma: 0.5 },
+            "Gaussian σ 0.5 (-gaussian_filter 0.5)",
+        ),
+    ];
+    for (f, text) in filters {
+        ui.radio_value(&mut filter, f, text);
+    }
+    if count == 1 && filter == Filter::default() {
+        return None;
+    }
+    // One sample is the pixel's centre whatever the sampler (the handout's default); the menu
+    // offers squares of 1 to 36 only, so every choice is a valid sampler.
+    let sampler = if count == 1 {
+        Sampler::default()
+    } else {
+        Sampler::new(kind, count, DEFAULT_SEED).ok()?
+    };
+    Some(Supersampling { sampler, filter })
 }

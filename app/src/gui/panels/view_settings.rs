@@ -53,6 +53,8 @@ pub struct ViewSettings {
     pub overlays: bool,
     /// Shadows, bounces, weight and the specular fix (View › Rays); the course's defaults.
     pub secondary: Secondary,
+    /// Assignment 7's sampler and filter (View › Supersampling); `None`: one ray a pixel.
+    pub supersample: Option<tracelab_core::render::Supersampling>,
 }
 
 impl Default for ViewSettings {
@@ -70,6 +72,7 @@ impl Default for ViewSettings {
             gizmo_axes: Axes::World,
             overlays: true,
             secondary: Secondary::default(),
+            supersample: None,
         }
     }
 }

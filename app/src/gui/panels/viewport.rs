@@ -340,6 +340,7 @@ impl Viewport {
             object_rays: s.object_rays,
             variant: None,
             secondary: s.secondary,
+            supersample: s.supersample,
         }
     }
 }

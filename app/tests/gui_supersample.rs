@@ -1,0 +1,76 @@
+//! View › Supersampling (assignment 7) in the editor: the picture on screen refines to the
+//! sampler and filter asked for, the same image a library render with them gives.
+
+mod common;
+use common::settle;
+
+use egui_kittest::Harness;
+use tracelab::gui::command::AppCommand;
+use tracelab::gui::{AppOptions, TracelabApp};
+use tracelab_core::render::{Filter, Sampler, SamplerKind, Supersampling};
+use tracelab_core::{CompiledScene, MeshCache, RenderSettings};
+
+const SIZE: (u32, u32) = (160, 160);
+
+fn harness(scene: std::path::PathBuf) -> Harness<'static, TracelabApp> {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            TracelabApp::new(
+                Some(cc),
+                AppOptions {
+                    scene: Some(scene),
+                    fixed_size: Some(SIZE),
+                    ..AppOptions::default()
+                },
+            )
+        });
+    settle(&mut h);
+    h
+}
+
+#[test]
+fn supersampling_renders_the_filtered_film_on_screen() {
+    let dir = common::temp_dir("gui-supersample", "menu");
+    let path = dir.join("scene.txt");
+    std::fs::copy(common::repo().join("scenes/default.txt"), &path).expect("copy");
+    let mut h = harness(path.clone());
+    let shown = |h: &Harness<'static, TracelabApp>| h.state().shown()[0].rgb8();
+    let before = shown(&h);
+    let (w, hgt) = SIZE;
+    let library = |ss: Option<Supersampling>| {
+        let mut cache = MeshCache::new();
+        let (scene, _) = tracelab_core::load_scene(&path, &mut cache)
+            .into_result()
+            .expect("loads");
+        let c = CompiledScene::new(&scene);
+        let s = RenderSettings {
+            supersample: ss,
+            ..RenderSettings::new(w, hgt)
+        };
+        let target = tracelab_core::SharedFrame::new();
+        let Ok(()) = tracelab_core::render::render(
+            &c,
+            &s,
+            tracelab_core::render::RenderPlan::PROGRESSIVE,
+            &target,
+            &tracelab_core::render::Uncancellable,
+            |_| {},
+        );
+        target.take().rgb8(tracelab_core::View::Color, (0.0, 1.0))
+    };
+    assert_eq!(before, library(None));
+    let ss = Supersampling {
+        sampler: Sampler::new(SamplerKind::Jittered, 4, 6837).expect("a valid sampler"),
+        filter: Filter::tent(1.5).expect("a valid filter"),
+    };
+    h.state_mut().queue(AppCommand::SetSupersampling(Some(ss)));
+    settle(&mut h);
+    let after = shown(&h);
+    assert_ne!(
+        after, before,
+        "View › Supersampling changed nothing on screen"
+    );
+    assert_eq!(after, library(Some(ss)));
+}
