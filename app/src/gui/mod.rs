@@ -22,6 +22,7 @@ pub mod overlays;
 pub mod panels;
 pub mod ray_diagram;
 pub mod settings;
+pub mod view_menus;
 pub mod view_tools;
 pub mod widgets;
 
