@@ -1605,6 +1605,31 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
 }
 
 #[test]
+fn a_camera_angle_of_180_is_refused_beside_the_angle_not_clamped() {
+    // The inspector has no limits of its own: the rules judge the angle, and say why beside it.
+    let path = temp_dir("angle180").join("perspective.txt");
+    let text = SPHERE_SCENE
+        .replace(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
+            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
+        )
+        .replace("OP", "Translate 0 0 0");
+    std::fs::write(&path, text).expect("write");
+    let mut h = harness(Some(path), (16, 16));
+    settle(&mut h);
+    select_row(&mut h, "Camera (perspective)");
+    type_into(&mut h, "angle (degrees)", "180");
+    let angle = |h: &Harness<'static, TracelabApp>| match h.state().doc.scene.camera {
+        tracelab_core::Camera::Perspective { angle, .. } => angle,
+        _ => panic!("a perspective camera"),
+    };
+    assert_eq!(angle(&h), 30.0, "180 was stored");
+    let _ = h.get_by_label("PerspectiveCamera: angle must be between 0 and 180 degrees, found 180");
+    type_into(&mut h, "angle (degrees)", "179.5");
+    assert_eq!(angle(&h), 179.5, "a valid angle past the old clamp goes in");
+}
+
+#[test]
 #[ignore = "needs the course files: TRACELAB_COURSE_DIR, default ../shared/mit6837"]
 fn scale_y_zero_on_the_squashed_sphere_is_refused_and_ctrl_s_leaves_a_file_that_opens() {
     let (mut h, path) = squashed_sphere("scale0");

@@ -5,7 +5,8 @@
 use glam::{Mat4, Vec3};
 use tracelab_core::scene::{DEFAULT_ATTENUATION, LightKind};
 use tracelab_core::{
-    Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
+    Background, Camera, CsgOp, Field, Light, Material, MeshSlot, NodeId, NodeKind, Place,
+    TransformOp,
 };
 
 use crate::document::edit::Edit;
@@ -121,10 +122,10 @@ fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
             up,
             size,
         } => {
-            changed |= vec3(ui, "center", center, speeds.length(1.0));
-            changed |= vec3(ui, "direction", direction, 0.01);
-            changed |= vec3(ui, "up", up, 0.01);
-            changed |= scalar(ui, "size", size, DragSpeeds::factor(*size));
+            changed |= vec3(ui, "center", Field::Center, center, speeds.length(1.0));
+            changed |= vec3(ui, "direction", Field::Direction, direction, 0.01);
+            changed |= vec3(ui, "up", Field::Up, up, 0.01);
+            changed |= scalar(ui, "size", Field::Size, size, DragSpeeds::factor(*size));
         }
         Camera::Perspective {
             center,
@@ -132,11 +133,12 @@ fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
             up,
             angle,
         } => {
-            changed |= vec3(ui, "center", center, speeds.length(1.0));
-            changed |= vec3(ui, "direction", direction, 0.01);
-            changed |= vec3(ui, "up", up, 0.01);
-            changed |= scalar(ui, "angle (degrees)", angle, 0.1);
-            *angle = angle.clamp(0.1, 179.0);
+            changed |= vec3(ui, "center", Field::Center, center, speeds.length(1.0));
+            changed |= vec3(ui, "direction", Field::Direction, direction, 0.01);
+            changed |= vec3(ui, "up", Field::Up, up, 0.01);
+            // No clamp of its own: an angle out of (0, 180) is refused by the rules, beside
+            // the field.
+            changed |= scalar(ui, "angle (degrees)", Field::Angle, angle, 0.1);
         }
     }
     if changed {
@@ -153,14 +155,14 @@ fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
     let mut changed = match &mut l.kind {
         LightKind::Directional { direction } => {
             ui.strong(format!("Light {i} (directional)"));
-            vec3(ui, "direction", direction, 0.01)
+            vec3(ui, "direction", Field::Direction, direction, 0.01)
         }
         LightKind::Point {
             position,
             attenuation,
         } => {
             ui.strong(format!("Light {i} (point)"));
-            let mut changed = vec3(ui, "position", position, 0.01);
+            let mut changed = vec3(ui, "position", Field::Position, position, 0.01);
             // Absent means the course's 1 0 0, and stays absent until given.
             let mut on = attenuation.is_some();
             if ui
@@ -171,12 +173,12 @@ fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
                 changed = true;
             }
             if let Some(a) = attenuation {
-                changed |= vec3(ui, "attenuation", a, 0.01);
+                changed |= vec3(ui, "attenuation", Field::Attenuation, a, 0.01);
             }
             changed
         }
     };
-    changed |= color(ui, "colour", &mut l.color);
+    changed |= color(ui, "colour", Field::Color, &mut l.color);
     if changed {
         edits.push(Edit::SetLight { index: i, light: l });
     }
@@ -189,15 +191,18 @@ fn background(ui: &mut egui::Ui, bg: &Background, edits: &mut Vec<Edit>) {
     ui.heading("Background");
     let mut b = bg.clone();
     let mut changed = false;
-    for (name, field) in [("colour", &mut b.color), ("ambient light", &mut b.ambient)] {
-        let mut on = field.is_some();
+    for (name, field, value) in [
+        ("colour", Field::Color, &mut b.color),
+        ("ambient light", Field::AmbientLight, &mut b.ambient),
+    ] {
+        let mut on = value.is_some();
         ui.horizontal(|ui| {
             if ui.checkbox(&mut on, "").changed() {
-                *field = on.then_some(Vec3::ZERO);
+                *value = on.then_some(Vec3::ZERO);
                 changed = true;
             }
-            if let Some(c) = field {
-                changed |= color(ui, name, c);
+            if let Some(c) = value {
+                changed |= color(ui, name, field.clone(), c);
             } else {
                 ui.label(format!("{name} (not set: black)"));
             }
@@ -255,7 +260,7 @@ fn color_and_phong(ui: &mut egui::Ui, i: usize, m: &mut Material, edits: &mut Ve
         // Remove under the colour, not beside it: beside, the row was wider than the panel
         // and egui widened the inspector by 60 points, pushing the picture aside.
         let mut c = m.diffuse;
-        if color(ui, &format!("{i}: diffuse"), &mut c) {
+        if color(ui, &format!("{i}: diffuse"), Field::DiffuseColor, &mut c) {
             m.diffuse = c;
             edits.push(Edit::SetMaterial {
                 index: i,
@@ -308,7 +313,7 @@ fn node(
                     ui.selectable_value(&mut chosen, Some(m), text(Some(m)));
                 }
             });
-        refusal_note(ui, "material");
+        refusal_note(ui, &Field::MaterialIndex);
         if chosen != current {
             edits.push(Edit::SetNodeMaterial {
                 node: id,
@@ -332,8 +337,8 @@ fn node(
             ui.label(format!("{} objects", n.children.len()));
         }
         NodeKind::Sphere { center, radius } => {
-            let mut c = vec3(ui, "center", center, len);
-            c |= scalar(ui, "radius", radius, len);
+            let mut c = vec3(ui, "center", Field::Center, center, len);
+            c |= scalar(ui, "radius", Field::Radius, radius, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -342,8 +347,8 @@ fn node(
             }
         }
         NodeKind::Plane { normal, offset } => {
-            let mut c = vec3(ui, "normal", normal, 0.01);
-            c |= scalar(ui, "offset", offset, len);
+            let mut c = vec3(ui, "normal", Field::Normal, normal, 0.01);
+            c |= scalar(ui, "offset", Field::Offset, offset, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -354,7 +359,7 @@ fn node(
         NodeKind::Triangle { vertices } => {
             let mut c = false;
             for (i, v) in vertices.iter_mut().enumerate() {
-                c |= vec3(ui, &format!("vertex{i}"), v, len);
+                c |= vec3(ui, &format!("vertex{i}"), Field::Vertex(i), v, len);
             }
             if c {
                 edits.push(Edit::SetNodeKind {
@@ -375,7 +380,7 @@ fn node(
             ui.horizontal(|ui| {
                 ui.label("obj_file");
                 ui.text_edit_singleline(&mut path);
-                refusal_note(ui, "obj_file");
+                refusal_note(ui, &Field::ObjFile);
             });
             if path == *obj_file {
                 ui.data_mut(|d| d.remove::<String>(buf_id));
@@ -414,8 +419,8 @@ fn node(
             }
         }
         NodeKind::Box { min, max } => {
-            let mut c = vec3(ui, "min", min, len);
-            c |= vec3(ui, "max", max, len);
+            let mut c = vec3(ui, "min", Field::Min, min, len);
+            c |= vec3(ui, "max", Field::Max, max, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -482,7 +487,7 @@ fn transform_ops(
 ) {
     ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
     // The ops together (or the chain above them) flatten space.
-    refusal_note(ui, "ops");
+    refusal_note(ui, &Field::Ops);
     let n = ops.len();
     for (index, op) in ops.iter_mut().enumerate() {
         ui.push_id(index, |ui| {
@@ -490,19 +495,35 @@ fn transform_ops(
             ui.group(|ui| {
                 let len = lengths.get(index).copied().unwrap_or(0.02);
                 let changed = match op {
-                    TransformOp::Translate(v) => vec3(ui, "Translate", v, len),
-                    TransformOp::Scale(v) => {
-                        vec3(ui, "Scale", v, DragSpeeds::factor(v.abs().max_element()))
+                    TransformOp::Translate(v) => {
+                        vec3(ui, "Translate", Field::Op("Translate"), v, len)
                     }
-                    TransformOp::UniformScale(s) => {
-                        scalar(ui, "UniformScale", s, DragSpeeds::factor(*s))
+                    TransformOp::Scale(v) => vec3(
+                        ui,
+                        "Scale",
+                        Field::Op("Scale"),
+                        v,
+                        DragSpeeds::factor(v.abs().max_element()),
+                    ),
+                    TransformOp::UniformScale(s) => scalar(
+                        ui,
+                        "UniformScale",
+                        Field::Op("UniformScale"),
+                        s,
+                        DragSpeeds::factor(*s),
+                    ),
+                    TransformOp::XRotate(d) => {
+                        scalar(ui, "XRotate (degrees)", Field::Op("XRotate"), d, 0.5)
                     }
-                    TransformOp::XRotate(d) => scalar(ui, "XRotate (degrees)", d, 0.5),
-                    TransformOp::YRotate(d) => scalar(ui, "YRotate (degrees)", d, 0.5),
-                    TransformOp::ZRotate(d) => scalar(ui, "ZRotate (degrees)", d, 0.5),
+                    TransformOp::YRotate(d) => {
+                        scalar(ui, "YRotate (degrees)", Field::Op("YRotate"), d, 0.5)
+                    }
+                    TransformOp::ZRotate(d) => {
+                        scalar(ui, "ZRotate (degrees)", Field::Op("ZRotate"), d, 0.5)
+                    }
                     TransformOp::Rotate { axis, degrees } => {
-                        let a = vec3(ui, "Rotate axis", axis, 0.01);
-                        scalar(ui, "Rotate degrees", degrees, 0.5) || a
+                        let a = vec3(ui, "Rotate axis", Field::Op("Rotate"), axis, 0.01);
+                        scalar(ui, "Rotate degrees", Field::Op("Rotate"), degrees, 0.5) || a
                     }
                     TransformOp::Matrix(m) => matrix(ui, m),
                 };
@@ -554,7 +575,7 @@ fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
         ui.label("Matrix (rows)");
-        refusal_note(ui, "Matrix");
+        refusal_note(ui, &Field::Op("Matrix"));
     });
     let mut rows = [
         m.row(0).to_array(),
