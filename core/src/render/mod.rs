@@ -19,6 +19,7 @@ mod rule_gap;
 mod rules;
 mod shade;
 mod shade_lanes;
+mod shape;
 mod similitude;
 pub mod texture;
 mod whitted;
