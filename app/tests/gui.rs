@@ -193,6 +193,16 @@ Group { numObjects 1 MaterialIndex 0
   Transform { OP Sphere { center 0 0 0 radius 1 } } }
 ";
 
+/// `SPHERE_SCENE` seen by a perspective camera of 30 degrees, its Transform's ops `op`.
+fn perspective_sphere_scene(op: &str) -> String {
+    SPHERE_SCENE
+        .replace(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
+            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
+        )
+        .replace("OP", op)
+}
+
 /// Normal-view bytes with the switch on Correct, then on Incorrect (clicked in the UI).
 fn normals_both_ways(op: &str, tag: &str) -> (Vec<u8>, Vec<u8>) {
     let path = temp_dir(tag).join("sphere.txt");
@@ -1244,12 +1254,7 @@ fn drag_by(h: &mut Harness<'static, TracelabApp>, label: &str, dx: f32) {
 fn dragging_a_translate_moves_by_a_step_scaled_to_the_scene_and_the_transform() {
     // The camera sees about 5.4 units across; the Translate is scaled by 5 (listed after it).
     let path = temp_dir("drag-speed").join("scaled.txt");
-    let text = SPHERE_SCENE
-        .replace(
-            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
-            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
-        )
-        .replace("OP", "UniformScale 5 Translate 0 0 0")
+    let text = perspective_sphere_scene("UniformScale 5 Translate 0 0 0")
         .replace("radius 1", "radius 0.1");
     std::fs::write(&path, text).expect("write");
     let mut h = harness(Some(path), (16, 16));
@@ -1619,12 +1624,7 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
 fn a_camera_angle_of_180_is_refused_beside_the_angle_not_clamped() {
     // The inspector has no limits of its own: the rules judge the angle, and say why beside it.
     let path = temp_dir("angle180").join("perspective.txt");
-    let text = SPHERE_SCENE
-        .replace(
-            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
-            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
-        )
-        .replace("OP", "Translate 0 0 0");
+    let text = perspective_sphere_scene("Translate 0 0 0");
     std::fs::write(&path, text).expect("write");
     let mut h = harness(Some(path), (16, 16));
     settle(&mut h);
