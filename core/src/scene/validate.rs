@@ -642,8 +642,31 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
     let mut out = Vec::new();
     // Nodes whose own parameters break a rule: their chain says the same thing again.
     let mut own = std::collections::HashSet::new();
+    // Every Transform's world-from-object matrix, composed in f64 through its whole chain
+    // of ancestors, in the same walk; only the outermost failing Transform of a chain is
+    // reported (`below`: its depth, while the walk is inside it).
+    let mut chain = Vec::new();
+    let mut below: Option<usize> = None;
     for v in Walk::new(graph) {
         let (id, node, parent) = (v.id, v.node, v.parent);
+        if below.is_some_and(|d| v.depth > d) {
+            // Inside a chain already reported.
+        } else if let NodeKind::Transform(_) = &node.kind
+            && let Err(e) = check_world_from_object(&v.world_from_object)
+        {
+            let message = e.to_string();
+            chain.push(Problem {
+                place: Place::Node(id),
+                field: Field::Ops,
+                op: None,
+                reason: message.clone(),
+                message,
+                incomplete: false,
+            });
+            below = Some(v.depth);
+        } else {
+            below = None;
+        }
         let name = node.kind.name();
         let mut push = |field: Field, op: Option<usize>, reason: String, incomplete: bool| {
             // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
@@ -719,7 +742,7 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
         }
     }
     out.extend(
-        check_world_chain(graph)
+        chain
             .into_iter()
             .filter(|p| !own.contains(&p.place))
             .map(|p| Problem {
@@ -731,31 +754,6 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
                 ..p
             }),
     );
-    out
-}
-
-/// Every Transform's world-from-object matrix, composed in f64 through its whole chain of
-/// ancestors. Only the outermost failing Transform of a chain is reported; messages do not
-/// name the node (the parser gives its location instead).
-pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
-    let mut out = Vec::new();
-    let mut walk = Walk::new(graph);
-    while let Some(v) = walk.next() {
-        if let NodeKind::Transform(_) = &v.node.kind
-            && let Err(e) = check_world_from_object(&v.world_from_object)
-        {
-            let message = e.to_string();
-            out.push(Problem {
-                place: Place::Node(v.id),
-                field: Field::Ops,
-                op: None,
-                reason: message.clone(),
-                message,
-                incomplete: false,
-            });
-            walk.skip_children();
-        }
-    }
     out
 }
 

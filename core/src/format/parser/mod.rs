@@ -23,7 +23,7 @@ use super::token_stream::TokenStream;
 
 use crate::scene::{
     Background, Camera, CsgOp, Field, Graph, Light, Material, NodeId, NodeKind, Place, Problem,
-    Scene, SceneComments, Walk, validate,
+    Scene, SceneComments, validate,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -391,11 +391,11 @@ impl Parser<'_> {
     /// and where it stands: the resolve step checks that it is closed.
     fn mesh_operands(&self, graph: &Graph) -> Vec<(NodeId, CsgOp, usize)> {
         let mut out = Vec::new();
-        for v in Walk::new(graph) {
-            let NodeKind::Csg(op) = v.node.kind else {
+        for (_, node) in graph.iter() {
+            let NodeKind::Csg(op) = node.kind else {
                 continue;
             };
-            for &c in &v.node.children {
+            for &c in &node.children {
                 let mut cur = c;
                 while let Some(NodeKind::Transform(_)) = graph.get(cur).map(|n| &n.kind) {
                     match graph.node(cur).children.first() {
