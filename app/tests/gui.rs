@@ -49,7 +49,7 @@ fn harness(scene: Option<PathBuf>, size: (u32, u32)) -> Harness<'static, Tracela
 
 /// The first Transform in the scene whose first op is a Translate.
 fn translate_transform(app: &TracelabApp) -> (NodeId, Vec3) {
-    app.doc
+    app.doc()
         .scene
         .graph
         .iter()
@@ -70,56 +70,56 @@ fn edit_save_undo(scene: PathBuf) {
     settle(&mut h);
     assert!(
         h.state()
-            .doc
+            .doc()
             .messages
             .iter()
             .all(|m| m.text.contains("warning")),
         "{:?}",
-        h.state().doc.messages
+        h.state().doc().messages
     );
-    let original = h.state().doc.scene.clone();
+    let original = h.state().doc().scene.clone();
     let (id, t) = translate_transform(h.state());
 
-    let label = tracelab::node_label::node_label(&h.state().doc.scene.graph.node(id).kind, 1);
+    let label = tracelab::node_label::node_label(&h.state().doc().scene.graph.node(id).kind, 1);
     h.get_all_by_label_contains(&label)
         .next()
         .expect("tree row")
         .click();
     h.step();
-    assert_eq!(h.state().doc.selection, Some(Selection::Node(id)));
+    assert_eq!(h.state().doc().selection, Some(Selection::Node(id)));
 
-    let gen_before = h.state().doc.generation;
-    let worker_before = h.state().worker.last_generation();
+    let gen_before = h.state().doc().generation;
+    let worker_before = h.state().worker().last_generation();
     let new_x = t.x + 0.75;
     h.get_by_label("Translate x")
         .set_value_accesskit(f64::from(new_x));
     h.step();
     h.step();
     let app = h.state();
-    let NodeKind::Transform(ops) = &app.doc.scene.graph.node(id).kind else {
+    let NodeKind::Transform(ops) = &app.doc().scene.graph.node(id).kind else {
         panic!("still a Transform")
     };
     assert_eq!(ops[0], TransformOp::Translate(Vec3::new(new_x, t.y, t.z)));
-    assert!(app.doc.generation > gen_before, "the document changed");
-    assert!(app.doc.is_dirty());
+    assert!(app.doc().generation > gen_before, "the document changed");
+    assert!(app.doc().is_dirty());
     assert!(
-        app.worker.last_generation() > worker_before,
+        app.worker().last_generation() > worker_before,
         "the render restarted"
     );
     settle(&mut h);
     let shown = h
         .state()
-        .worker
+        .worker()
         .with_published(|p| p.map(|p| p.job.generation));
     assert_eq!(
         shown,
-        Some(h.state().doc.generation),
+        Some(h.state().doc().generation),
         "the image shows the edited scene"
     );
 
     let out = temp_dir("save").join(scene.file_name().expect("name"));
     h.state_mut().save_as(&out);
-    assert!(!h.state().doc.is_dirty());
+    assert!(!h.state().doc().is_dirty());
     let back = tracelab_core::load_scene(&out, &mut MeshCache::new())
         .into_result()
         .expect("saved file reads back")
@@ -137,7 +137,7 @@ fn edit_save_undo(scene: PathBuf) {
     let dir = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
     tracelab_core::rebase_mesh_paths(&mut original, &dir(&scene), &dir(&out));
     assert_eq!(
-        h.state().doc.scene,
+        h.state().doc().scene,
         original,
         "undo restores the identical document"
     );
@@ -160,7 +160,7 @@ fn own_scene_edit_save_and_undo() {
 fn syntax_error_shows_its_location_and_keeps_the_scene() {
     let mut h = harness(None, (32, 32));
     settle(&mut h);
-    let before = h.state().doc.scene.clone();
+    let before = h.state().doc().scene.clone();
     let bad = temp_dir("bad").join("broken.txt");
     std::fs::write(
         &bad,
@@ -171,8 +171,12 @@ fn syntax_error_shows_its_location_and_keeps_the_scene() {
     // Read in the background: wait for its answer.
     step_until(&mut h, 10, "the error", |a| !a.is_loading());
     h.step();
-    assert_eq!(h.state().doc.scene, before, "the previous scene stays open");
-    let msg = h.state().doc.messages.joined();
+    assert_eq!(
+        h.state().doc().scene,
+        before,
+        "the previous scene stays open"
+    );
+    let msg = h.state().doc().messages.joined();
     assert!(msg.contains("broken.txt:3:"), "{msg}");
     // Shown in the window, with file:line:col.
     let _ = h.get_by_label_contains("broken.txt:3:");
@@ -189,15 +193,25 @@ Group { numObjects 1 MaterialIndex 0
   Transform { OP Sphere { center 0 0 0 radius 1 } } }
 ";
 
+/// `SPHERE_SCENE` seen by a perspective camera of 30 degrees, its Transform's ops `op`.
+fn perspective_sphere_scene(op: &str) -> String {
+    SPHERE_SCENE
+        .replace(
+            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
+            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
+        )
+        .replace("OP", op)
+}
+
 /// Normal-view bytes with the switch on Correct, then on Incorrect (clicked in the UI).
 fn normals_both_ways(op: &str, tag: &str) -> (Vec<u8>, Vec<u8>) {
     let path = temp_dir(tag).join("sphere.txt");
     std::fs::write(&path, SPHERE_SCENE.replace("OP", op)).expect("write");
     let mut h = harness(Some(path), (40, 40));
-    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::Normals;
+    h.state_mut().view_mut().tab = tracelab::gui::panels::viewport::Tab::Normals;
     settle(&mut h);
     let grab = |h: &Harness<'static, TracelabApp>| {
-        h.state().worker.with_published(|p| {
+        h.state().worker().with_published(|p| {
             p.expect("rendered").frames[0]
                 .lock()
                 .rgb8(View::Normals, (0.0, 1.0))
@@ -208,7 +222,7 @@ fn normals_both_ways(op: &str, tag: &str) -> (Vec<u8>, Vec<u8>) {
     h.step();
     settle(&mut h);
     assert_eq!(
-        h.state().view.normal_transform,
+        h.state().view().normal_transform,
         tracelab_core::NormalTransform::Incorrect
     );
     (correct, grab(&h))
@@ -243,11 +257,11 @@ fn closing_with_unsaved_changes_asks_first() {
         .push(egui::ViewportEvent::Close);
     h.step();
     h.step();
-    assert_eq!(h.state().confirm, Some(Pending::Close));
+    assert_eq!(h.state().confirm(), Some(&Pending::Close));
     h.get_by_label("Cancel").click();
     h.step();
-    assert_eq!(h.state().confirm, None);
-    assert!(h.state().doc.is_dirty(), "cancel keeps the edits");
+    assert_eq!(h.state().confirm(), None);
+    assert!(h.state().doc().is_dirty(), "cancel keeps the edits");
 }
 
 #[test]
@@ -255,10 +269,10 @@ fn clicking_a_pixel_selects_its_node_and_tells_the_ray_story() {
     let mut h = harness(None, (64, 48));
     settle(&mut h);
     // A pixel showing an object that sits under a Transform (the built-in scene has several).
-    let pixel = h.state().worker.with_published(|p| {
+    let pixel = h.state().worker().with_published(|p| {
         let p = p.expect("rendered");
         let f = p.frames[0].lock();
-        let g = &h.state().doc.scene.graph;
+        let g = &h.state().doc().scene.graph;
         (0..f.height)
             .flat_map(|row| (0..f.width).map(move |x| (x, row)))
             .find(|&(x, row)| {
@@ -277,9 +291,9 @@ fn clicking_a_pixel_selects_its_node_and_tells_the_ray_story() {
         h.step();
     }
     let app = h.state();
-    let (story, _) = app.story.as_ref().expect("a story");
+    let (story, _) = app.story().expect("a story");
     let hit = story.hit.as_ref().expect("the ray hits something");
-    assert_eq!(app.doc.selection, Some(Selection::Node(hit.node)));
+    assert_eq!(app.doc().selection, Some(Selection::Node(hit.node)));
     assert!(hit.path.iter().any(|s| s.kind == "Transform"));
     let _ = h.get_by_label_contains("world normal by (M^-1)^T");
 }
@@ -301,23 +315,23 @@ fn recent_files_and_view_settings_persist() {
     }
     let mut a = TracelabApp::new(None, AppOptions::default());
     assert!(a.open_now(&repo("scenes/hierarchy.txt")));
-    a.view.tab = tracelab::gui::panels::viewport::Tab::Depth;
-    a.view.depth = (3.0, 12.5);
+    a.view_mut().tab = tracelab::gui::panels::viewport::Tab::Depth;
+    a.view_mut().depth = (3.0, 12.5);
     let mut m = Mem(Default::default());
     eframe::App::save(&mut a, &mut m);
     let mut b = TracelabApp::new(None, AppOptions::default());
     b.load_persisted(&m);
     // Kept canonical, so the entry works from any folder (issue 26 bug 5).
     let canonical = std::fs::canonicalize(repo("scenes/hierarchy.txt")).expect("canonical");
-    assert_eq!(b.recent, vec![canonical]);
-    assert_eq!(b.view.tab, tracelab::gui::panels::viewport::Tab::Depth);
-    assert_eq!(b.view.depth, (3.0, 12.5));
+    assert_eq!(b.recent(), vec![canonical]);
+    assert_eq!(b.view().tab, tracelab::gui::panels::viewport::Tab::Depth);
+    assert_eq!(b.view().depth, (3.0, 12.5));
 }
 
 #[test]
 fn export_all_three_writes_every_view() {
     let mut h = harness(None, (32, 24));
-    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::All;
+    h.state_mut().view_mut().tab = tracelab::gui::panels::viewport::Tab::All;
     settle(&mut h);
     let out = temp_dir("export").join("shot.png");
     let files = h.state_mut().export(&out).expect("exports");
@@ -357,7 +371,7 @@ fn export_never_writes_the_open_scene_or_through_a_planted_link() {
     // The names made for "All three" never follow a symlink, and nothing is written.
     std::fs::write(d.join("victim.txt"), "keep").expect("write");
     std::os::unix::fs::symlink("victim.txt", d.join("shot_normals.png")).expect("plant");
-    h.state_mut().view.tab = tracelab::gui::panels::viewport::Tab::All;
+    h.state_mut().view_mut().tab = tracelab::gui::panels::viewport::Tab::All;
     settle(&mut h);
     let e = h
         .state_mut()
@@ -383,7 +397,7 @@ fn a_file_changed_on_disk_is_reloaded() {
     let start = Instant::now();
     loop {
         h.step();
-        let reloaded = h.state().doc.scene.graph.iter().any(|(_, n)| {
+        let reloaded = h.state().doc().scene.graph.iter().any(|(_, n)| {
             matches!(&n.kind, NodeKind::Transform(ops) if ops.first() == Some(&TransformOp::UniformScale(0.5)))
         });
         if reloaded {
@@ -392,7 +406,7 @@ fn a_file_changed_on_disk_is_reloaded() {
         assert!(start.elapsed() < Duration::from_secs(5), "not reloaded");
         std::thread::sleep(Duration::from_millis(50));
     }
-    assert!(!h.state().doc.is_dirty());
+    assert!(!h.state().doc().is_dirty());
 }
 
 #[derive(Debug)]
@@ -416,10 +430,10 @@ fn a_scene_dropped_on_the_window_opens() {
         .dropped_files
         .push(std::sync::Arc::new(Dropped(path.clone())));
     step_until(&mut h, 10, "the dropped scene", |a| {
-        a.doc.path.as_deref() == Some(path.as_path())
+        a.doc().path.as_deref() == Some(path.as_path())
     });
     let canonical = std::fs::canonicalize(&path).expect("canonical");
-    assert_eq!(h.state().recent.first(), Some(&canonical));
+    assert_eq!(h.state().recent().first(), Some(&canonical));
 }
 
 #[test]
@@ -433,14 +447,18 @@ fn opening_over_unsaved_changes_asks_and_discard_opens() {
     let target = repo("scenes/hierarchy.txt");
     h.state_mut().open(&target);
     // The file is read first; the question comes once there is something to switch to.
-    step_until(&mut h, 10, "the question", |a| a.confirm.is_some());
+    step_until(&mut h, 10, "the question", |a| a.confirm().is_some());
     h.step();
-    assert_eq!(h.state().confirm, Some(Pending::Open(target.clone())));
-    assert_eq!(h.state().doc.path, None, "nothing opened before the answer");
+    assert_eq!(h.state().confirm(), Some(&Pending::Open(target.clone())));
+    assert_eq!(
+        h.state().doc().path,
+        None,
+        "nothing opened before the answer"
+    );
     h.get_by_label("Discard changes").click();
     h.step();
-    assert_eq!(h.state().doc.path.as_deref(), Some(target.as_path()));
-    assert!(!h.state().doc.is_dirty());
+    assert_eq!(h.state().doc().path.as_deref(), Some(target.as_path()));
+    assert!(!h.state().doc().is_dirty());
 }
 
 #[test]
@@ -461,17 +479,17 @@ fn a_missing_obj_is_an_error_on_its_node_not_a_failure_to_open() {
     settle(&mut h);
     let app = h.state();
     assert_eq!(
-        app.doc.path.as_deref(),
+        app.doc().path.as_deref(),
         Some(path.as_path()),
         "the scene opened"
     );
     assert!(
-        app.doc
+        app.doc()
             .messages
             .iter()
             .any(|m| m.text.contains("nowhere.obj")),
         "{:?}",
-        app.doc.messages
+        app.doc().messages
     );
     let _ = h.get_by_label_contains("TriangleMesh: nowhere.obj (not loaded)");
 }
@@ -484,7 +502,7 @@ fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
     for _ in 0..3 {
         h.step();
     }
-    assert!(h.state().dialog.is_some());
+    assert!(h.state().dialog().is_some());
     let target = repo("scenes/flat_transforms.txt");
     h.get_by_role(egui::accesskit::Role::TextInput).focus();
     h.step();
@@ -493,16 +511,16 @@ fn ctrl_o_opens_the_file_dialog_and_it_opens_a_typed_name() {
     h.step();
     h.get_by_label("Open").click();
     step_until(&mut h, 10, "the file to open", |a| {
-        a.doc.path.as_deref() == Some(target.as_path())
+        a.doc().path.as_deref() == Some(target.as_path())
     });
-    assert!(h.state().dialog.is_none());
+    assert!(h.state().dialog().is_none());
 }
 
 #[test]
 fn adding_a_triangle_mesh_and_loading_its_obj() {
     let mut h = harness(Some(repo("scenes/flat_transforms.txt")), (16, 16));
     settle(&mut h);
-    let before = h.state().doc.scene.graph.stats().triangles;
+    let before = h.state().doc().scene.graph.stats().triangles;
     h.get_by_label("Add").click();
     for _ in 0..2 {
         h.step();
@@ -511,7 +529,7 @@ fn adding_a_triangle_mesh_and_loading_its_obj() {
     for _ in 0..2 {
         h.step();
     }
-    let Some(Selection::Node(id)) = h.state().doc.selection else {
+    let Some(Selection::Node(id)) = h.state().doc().selection else {
         panic!("the new mesh is selected")
     };
     h.get_by_role(egui::accesskit::Role::TextInput).focus();
@@ -523,15 +541,16 @@ fn adding_a_triangle_mesh_and_loading_its_obj() {
     h.step();
     // Read on a thread (the window keeps painting): wait for it.
     step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
-    let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc.scene.graph.node(id).kind else {
+    let NodeKind::TriangleMesh { obj_file, mesh } = &h.state().doc().scene.graph.node(id).kind
+    else {
         panic!("a TriangleMesh")
     };
     assert_eq!(obj_file, "../assets/torus.obj");
     assert!(mesh.mesh().is_some(), "loaded: {mesh:?}");
-    assert!(h.state().doc.scene.graph.stats().triangles > before);
+    assert!(h.state().doc().scene.graph.stats().triangles > before);
     // Adding and loading are two undo steps; both undo cleanly.
-    assert!(h.state_mut().doc.undo() && h.state_mut().doc.undo());
-    assert_eq!(h.state().doc.scene.graph.stats().triangles, before);
+    assert!(h.state_mut().doc_mut().undo() && h.state_mut().doc_mut().undo());
+    assert_eq!(h.state().doc().scene.graph.stats().triangles, before);
 }
 
 #[test]
@@ -540,35 +559,35 @@ fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
     settle(&mut h);
     let csg = h
         .state()
-        .doc
+        .doc()
         .scene
         .graph
         .iter()
         .find(|(_, n)| matches!(n.kind, NodeKind::Csg(_)))
         .map(|(id, _)| id)
         .expect("the scene has a CSG node");
-    let before = h.state().doc.scene.graph.node(csg).children.clone();
+    let before = h.state().doc().scene.graph.node(csg).children.clone();
     h.get_by_label_contains("Subtraction: A minus B").click();
     h.step();
-    assert_eq!(h.state().doc.selection, Some(Selection::Node(csg)));
-    let generation = h.state().doc.generation;
+    assert_eq!(h.state().doc().selection, Some(Selection::Node(csg)));
+    let generation = h.state().doc().generation;
     h.get_by_label("Union").click();
     h.step();
     assert_eq!(
-        h.state().doc.scene.graph.node(csg).kind,
+        h.state().doc().scene.graph.node(csg).kind,
         NodeKind::Csg(tracelab_core::CsgOp::Union)
     );
     assert!(
-        h.state().doc.generation > generation,
+        h.state().doc().generation > generation,
         "the edit restarts the render"
     );
     h.get_by_label("Swap A and B").click();
     h.step();
-    let after = h.state().doc.scene.graph.node(csg).children.clone();
+    let after = h.state().doc().scene.graph.node(csg).children.clone();
     assert_eq!(after, [before[1], before[0]]);
     settle(&mut h);
     // Clicking the render on a CSG surface selects the operand it came from.
-    let pixel = h.state().worker.with_published(|p| {
+    let pixel = h.state().worker().with_published(|p| {
         let p = p.expect("rendered");
         let f = p.frames[0].lock();
         let s = f.get(16, 16).expect("in frame");
@@ -577,7 +596,7 @@ fn csg_nodes_show_in_the_tree_and_their_operation_can_be_changed_and_swapped() {
     let node = pixel.expect("the centre pixel shows the union");
     assert!(
         matches!(
-            h.state().doc.scene.graph.node(node).kind,
+            h.state().doc().scene.graph.node(node).kind,
             NodeKind::Sphere { .. }
         ),
         "an operand, not the CSG node"
@@ -603,7 +622,7 @@ fn the_picture_on_screen_follows_the_normal_switch_and_shade_back() {
     settle(&mut h);
     let correct = on_screen(&h);
     let rendered = |h: &Harness<'static, TracelabApp>| {
-        h.state().worker.with_published(|p| {
+        h.state().worker().with_published(|p| {
             p.expect("rendered").frames[0]
                 .lock()
                 .rgb8(View::Normals, (0.0, 1.0))
@@ -632,7 +651,7 @@ fn shade_back_changes_the_picture_of_an_inside_view() {
     h.get_by_label("shade back").click();
     h.step();
     settle(&mut h);
-    assert!(h.state().view.shade_back);
+    assert!(h.state().view().shade_back);
     assert_ne!(
         before,
         on_screen(&h),
@@ -664,7 +683,7 @@ fn step_until(
 }
 
 fn inspected_hit(app: &TracelabApp) -> Option<tracelab_core::render::HitStory> {
-    app.story.as_ref().and_then(|(s, _)| s.hit.clone())
+    app.story().and_then(|(s, _)| s.hit.clone())
 }
 
 #[test]
@@ -679,7 +698,7 @@ fn the_pixel_inspector_retraces_its_pixel_after_an_edit_and_keeps_the_selection(
     }
     let before = inspected_hit(h.state()).expect("the centre pixel hits the sphere");
     let (id, _) = translate_transform(h.state());
-    h.state_mut().doc.selection = Some(Selection::Node(id));
+    h.state_mut().doc_mut().selection = Some(Selection::Node(id));
     h.state_mut()
         .apply(tracelab::document::edit::Edit::SetTransformOp {
             node: id,
@@ -694,13 +713,13 @@ fn the_pixel_inspector_retraces_its_pixel_after_an_edit_and_keeps_the_selection(
         "the inspector kept the old story"
     );
     // Exactly what the new render's scene gives for that pixel.
-    let fresh = h.state().worker.with_published(|p| {
+    let fresh = h.state().worker().with_published(|p| {
         let p = p.expect("rendered");
         tracelab_core::render::inspect_pixel(&p.job.scene, &p.compiled, &p.job.settings, 20, 20)
     });
-    assert_eq!(Some(&fresh), h.state().story.as_ref().map(|(s, _)| s));
+    assert_eq!(Some(&fresh), h.state().story().map(|(s, _)| s));
     assert_eq!(
-        h.state().doc.selection,
+        h.state().doc().selection,
         Some(Selection::Node(id)),
         "re-tracing must not change the selection"
     );
@@ -756,7 +775,7 @@ fn mesh_scene(tag: &str, obj: &str) -> PathBuf {
 }
 
 fn mesh_node(app: &TracelabApp) -> NodeId {
-    app.doc
+    app.doc()
         .scene
         .graph
         .iter()
@@ -780,16 +799,16 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     let mut h = harness(Some(a), (16, 16));
     settle(&mut h);
     let id = mesh_node(h.state());
-    h.state_mut().doc.selection = Some(Selection::Node(id));
+    h.state_mut().doc_mut().selection = Some(Selection::Node(id));
     h.step();
     h.step();
     assert_eq!(obj_field(&h), cube);
     h.state_mut().open(&b);
     step_until(&mut h, 30, "the second scene", |a| {
-        a.doc.path.as_deref() == Some(b.as_path())
+        a.doc().path.as_deref() == Some(b.as_path())
     });
     assert_eq!(mesh_node(h.state()), id, "same shape, same node id");
-    h.state_mut().doc.selection = Some(Selection::Node(id));
+    h.state_mut().doc_mut().selection = Some(Selection::Node(id));
     h.step();
     h.step();
     assert_eq!(
@@ -800,7 +819,7 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
     h.get_by_label("Load / reload").click();
     h.step();
     step_until(&mut h, 10, "the mesh to load", |a| !a.is_loading());
-    let file = |app: &TracelabApp| match &app.doc.scene.graph.node(id).kind {
+    let file = |app: &TracelabApp| match &app.doc().scene.graph.node(id).kind {
         NodeKind::TriangleMesh { obj_file, .. } => obj_file.clone(),
         _ => String::new(),
     };
@@ -810,7 +829,7 @@ fn the_obj_file_field_shows_the_current_documents_value_after_open_undo_and_redo
         "Load swapped in the other scene's mesh"
     );
     // An edit from elsewhere, then undo and redo: the field follows each time.
-    let mut kind = h.state().doc.scene.graph.node(id).kind.clone();
+    let mut kind = h.state().doc().scene.graph.node(id).kind.clone();
     if let NodeKind::TriangleMesh { obj_file, .. } = &mut kind {
         *obj_file = cube.clone();
     }
@@ -854,7 +873,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
     let dragon = dragon_scene();
     let mut h = harness(None, (32, 32));
     settle(&mut h);
-    let before = h.state().doc.scene.clone();
+    let before = h.state().doc().scene.clone();
     let t = Instant::now();
     h.state_mut().open(&dragon);
     assert!(
@@ -863,7 +882,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
         t.elapsed()
     );
     assert_eq!(
-        h.state().doc.path,
+        h.state().doc().path,
         None,
         "the old scene stays open while the new one loads"
     );
@@ -879,7 +898,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
     }
     // Not assert_eq: the Debug of an 871k-triangle scene is hundreds of MB.
     assert!(
-        h.state().doc.scene == before,
+        h.state().doc().scene == before,
         "a cancelled load replaced the scene"
     );
     assert!(h.query_by_label_contains("Opening dragon.txt").is_none());
@@ -887,7 +906,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
     h.state_mut().open(&dragon);
     let mut slowest = Duration::ZERO;
     let start = Instant::now();
-    while h.state().doc.path.as_deref() != Some(dragon.as_path()) {
+    while h.state().doc().path.as_deref() != Some(dragon.as_path()) {
         let f = Instant::now();
         h.step();
         slowest = slowest.max(f.elapsed());
@@ -898,7 +917,7 @@ fn opening_a_large_mesh_keeps_the_window_painting_shows_progress_and_can_be_canc
         slowest < Duration::from_millis(300),
         "a frame took {slowest:?} while loading"
     );
-    assert_eq!(h.state().doc.scene.graph.stats().triangles, 871_414);
+    assert_eq!(h.state().doc().scene.graph.stats().triangles, 871_414);
 }
 
 #[test]
@@ -923,7 +942,7 @@ fn a_large_scene_given_at_start_does_not_hold_up_the_first_frame() {
     let ctx = egui::Context::default();
     let mut frames_before = 0;
     let mut slowest = Duration::ZERO;
-    while app.doc.path.as_deref() != Some(dragon.as_path()) {
+    while app.doc().path.as_deref() != Some(dragon.as_path()) {
         let f = Instant::now();
         let mut out = ctx.run_ui(egui::RawInput::default(), |ui| app.frame(ui));
         // No GPU here: the textures have nowhere to go.
@@ -951,7 +970,7 @@ fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() 
         .apply(tracelab::document::edit::Edit::AddMaterial(
             tracelab_core::Material::diffuse(Vec3::ONE),
         ));
-    let edited = h.state().doc.scene.clone();
+    let edited = h.state().doc().scene.clone();
     let bad = temp_dir("bad-dirty").join("broken.txt");
     std::fs::write(
         &bad,
@@ -960,19 +979,19 @@ fn a_file_that_fails_to_parse_over_unsaved_changes_is_reported_without_asking() 
     .expect("write");
     h.state_mut().open(&bad);
     step_until(&mut h, 10, "an answer", |a| {
-        a.confirm.is_some()
-            || a.doc
+        a.confirm().is_some()
+            || a.doc()
                 .messages
                 .iter()
                 .any(|m| m.text.contains("broken.txt:3:"))
     });
     assert_eq!(
-        h.state().confirm,
+        h.state().confirm(),
         None,
         "asked about unsaved changes with nothing to switch to"
     );
-    assert_eq!(h.state().doc.scene, edited);
-    assert!(h.state().doc.is_dirty());
+    assert_eq!(h.state().doc().scene, edited);
+    assert!(h.state().doc().is_dirty());
 }
 
 fn focus_text_and_type(h: &mut Harness<'static, TracelabApp>, text: &str) {
@@ -995,9 +1014,9 @@ fn enter_in_the_open_dialog_opens_the_typed_name() {
     focus_text_and_type(&mut h, &target.display().to_string());
     h.key_press(egui::Key::Enter);
     step_until(&mut h, 10, "the file to open", |a| {
-        a.doc.path.as_deref() == Some(target.as_path())
+        a.doc().path.as_deref() == Some(target.as_path())
     });
-    assert!(h.state().dialog.is_none());
+    assert!(h.state().dialog().is_none());
 }
 
 #[test]
@@ -1019,7 +1038,7 @@ fn enter_in_the_save_as_dialog_saves() {
         h.step();
     }
     assert!(out.is_file(), "Enter did not save");
-    assert!(h.state().dialog.is_none());
+    assert!(h.state().dialog().is_none());
 }
 
 #[test]
@@ -1030,10 +1049,11 @@ fn the_file_dialog_lists_scene_files_and_folders_only() {
     std::fs::create_dir_all(d.join("sub")).expect("mkdir");
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().dialog = Some(tracelab::gui::file_dialog::FileDialog::new(
-        tracelab::gui::file_dialog::Purpose::Open,
-        Some(&d.join("a.txt")),
-    ));
+    h.state_mut()
+        .set_dialog(Some(tracelab::gui::file_dialog::FileDialog::new(
+            tracelab::gui::file_dialog::Purpose::Open,
+            Some(&d.join("a.txt")),
+        )));
     for _ in 0..3 {
         h.step();
     }
@@ -1049,10 +1069,11 @@ fn the_file_dialog_lists_scene_files_and_folders_only() {
 fn the_file_dialog_never_shows_the_folder_as_a_dot() {
     let mut h = harness(None, (16, 16));
     settle(&mut h);
-    h.state_mut().dialog = Some(tracelab::gui::file_dialog::FileDialog::new(
-        tracelab::gui::file_dialog::Purpose::Open,
-        Some(Path::new("scene.txt")),
-    ));
+    h.state_mut()
+        .set_dialog(Some(tracelab::gui::file_dialog::FileDialog::new(
+            tracelab::gui::file_dialog::Purpose::Open,
+            Some(Path::new("scene.txt")),
+        )));
     for _ in 0..3 {
         h.step();
     }
@@ -1077,17 +1098,17 @@ fn file_new_asks_about_unsaved_changes_then_starts_an_untitled_scene() {
         h.step();
     }
     assert!(
-        h.state().confirm.is_some(),
+        h.state().confirm().is_some(),
         "New over unsaved changes must ask"
     );
     h.get_by_label("Discard changes").click();
     for _ in 0..2 {
         h.step();
     }
-    assert_eq!(h.state().doc.path, None);
-    assert!(!h.state().doc.is_dirty());
+    assert_eq!(h.state().doc().path, None);
+    assert!(!h.state().doc().is_dirty());
     assert_eq!(
-        h.state().doc.scene,
+        h.state().doc().scene,
         tracelab::document::Document::builtin().scene
     );
 }
@@ -1104,7 +1125,7 @@ fn ctrl_q_quits_asking_first_about_unsaved_changes() {
     for _ in 0..3 {
         h.step();
     }
-    assert_eq!(h.state().confirm, Some(Pending::Close));
+    assert_eq!(h.state().confirm(), Some(&Pending::Close));
 }
 
 #[test]
@@ -1120,7 +1141,7 @@ fn a_new_sphere_inherits_the_groups_material_and_says_which() {
     for _ in 0..3 {
         h.step();
     }
-    let Some(Selection::Node(id)) = h.state().doc.selection else {
+    let Some(Selection::Node(id)) = h.state().doc().selection else {
         panic!("the new sphere is selected")
     };
     let shown = h.get_by_label("material").value().unwrap_or_default();
@@ -1129,7 +1150,7 @@ fn a_new_sphere_inherits_the_groups_material_and_says_which() {
         "the inspector says {shown:?}"
     );
     // What it shows is what it renders with, and what the saved file gives back.
-    let eff = h.state().doc.scene.graph.effective_materials()[id.index()];
+    let eff = h.state().doc().scene.graph.effective_materials()[id.index()];
     assert_eq!(eff, Some(0));
     let out = temp_dir("inherit").join("saved.txt");
     h.state_mut().save_as(&out);
@@ -1233,30 +1254,25 @@ fn drag_by(h: &mut Harness<'static, TracelabApp>, label: &str, dx: f32) {
 fn dragging_a_translate_moves_by_a_step_scaled_to_the_scene_and_the_transform() {
     // The camera sees about 5.4 units across; the Translate is scaled by 5 (listed after it).
     let path = temp_dir("drag-speed").join("scaled.txt");
-    let text = SPHERE_SCENE
-        .replace(
-            "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2.5 }",
-            "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }",
-        )
-        .replace("OP", "UniformScale 5 Translate 0 0 0")
+    let text = perspective_sphere_scene("UniformScale 5 Translate 0 0 0")
         .replace("radius 1", "radius 0.1");
     std::fs::write(&path, text).expect("write");
     let mut h = harness(Some(path), (16, 16));
     settle(&mut h);
     let id = h
         .state()
-        .doc
+        .doc()
         .scene
         .graph
         .iter()
         .find(|(_, n)| matches!(n.kind, NodeKind::Transform(_)))
         .map(|(id, _)| id)
         .expect("the Transform");
-    h.state_mut().doc.selection = Some(Selection::Node(id));
+    h.state_mut().doc_mut().selection = Some(Selection::Node(id));
     h.step();
     h.step();
     drag_by(&mut h, "Translate x", 60.0);
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(id).kind else {
+    let NodeKind::Transform(ops) = &h.state().doc().scene.graph.node(id).kind else {
         panic!()
     };
     let Some(TransformOp::Translate(t)) = ops.get(1) else {
@@ -1295,7 +1311,7 @@ fn a_side_panel_dragged_wide_leaves_the_render_view_usable() {
     settle(&mut h);
     let width = h
         .state()
-        .worker
+        .worker()
         .with_published(|p| p.expect("rendered").job.settings.width);
     assert!(width >= 300, "the render view is {width} px wide");
 }
@@ -1318,15 +1334,15 @@ fn the_fixed_render_size_refuses_nan_and_sizes_past_the_limit() {
     };
     type_into(&mut h, "w", "nan");
     assert_eq!(
-        h.state().view.fixed_size,
+        h.state().view().fixed_size,
         Some((40, 40)),
         "nan was taken as a size"
     );
     type_into(&mut h, "w", "8192");
-    assert_eq!(h.state().view.fixed_size, Some((8192, 40)));
+    assert_eq!(h.state().view().fixed_size, Some((8192, 40)));
     // 8192 × 16384 is more pixels than core renders (8192 × 8192).
     type_into(&mut h, "h", "16384");
-    let (w, hh) = h.state().view.fixed_size.expect("fixed");
+    let (w, hh) = h.state().view().fixed_size.expect("fixed");
     assert!(
         tracelab_core::render::check_image_size(w, hh).is_ok(),
         "{w}×{hh} accepted"
@@ -1352,14 +1368,14 @@ fn twenty_thousand_nested_groups_make_a_short_breadcrumb() {
     settle(&mut h);
     let sphere = h
         .state()
-        .doc
+        .doc()
         .scene
         .graph
         .iter()
         .find(|(_, n)| matches!(n.kind, NodeKind::Sphere { .. }))
         .map(|(id, _)| id)
         .expect("sphere");
-    h.state_mut().doc.selection = Some(Selection::Node(sphere));
+    h.state_mut().doc_mut().selection = Some(Selection::Node(sphere));
     h.step();
     h.step();
     let node = h.get_by_label_contains("Group › Group");
@@ -1410,7 +1426,7 @@ fn save_says_which_comments_it_would_drop_before_writing() {
         h.step();
     }
     assert_ne!(std::fs::read_to_string(&path).expect("read"), text);
-    assert!(!h.state().doc.is_dirty());
+    assert!(!h.state().doc().is_dirty());
 }
 
 fn layout_harness(width: f32, memory: Option<egui::Memory>) -> Harness<'static, TracelabApp> {
@@ -1436,7 +1452,7 @@ fn tree_edge(h: &Harness<'static, TracelabApp>) -> f32 {
 
 fn render_width(h: &Harness<'static, TracelabApp>) -> u32 {
     h.state()
-        .worker
+        .worker()
         .with_published(|p| p.expect("rendered").job.settings.width)
 }
 
@@ -1557,7 +1573,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
     h.get_by_label("TriangleMesh").click();
     h.step();
     h.step();
-    let Some(Selection::Node(mesh)) = h.state().doc.selection else {
+    let Some(Selection::Node(mesh)) = h.state().doc().selection else {
         panic!("the new mesh is selected")
     };
     ctrl_s(&mut h);
@@ -1566,7 +1582,7 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
         before,
         "Save wrote a file with no obj_file"
     );
-    let msg = h.state().doc.messages.joined();
+    let msg = h.state().doc().messages.joined();
     assert!(
         msg.contains("not saved")
             && msg.contains(&format!("node #{}): no OBJ file chosen yet", mesh.0)),
@@ -1574,9 +1590,9 @@ fn adding_a_triangle_mesh_then_saving_refuses_says_why_and_writes_nothing() {
     );
     // The explanation is on screen, and the tree shows the node in red (its row has an error).
     let _ = h.get_by_label_contains("not saved; first fix");
-    let rows = tracelab::gui::panels::tree::tree_rows(&h.state().doc.scene);
+    let rows = tracelab::gui::panels::tree::tree_rows(&h.state().doc().scene);
     assert!(rows.iter().any(|r| r.id == mesh && r.error.is_some()));
-    assert!(h.state().doc.is_dirty(), "nothing was saved");
+    assert!(h.state().doc().is_dirty(), "nothing was saved");
 }
 
 #[test]
@@ -1587,7 +1603,7 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
     for text in ["nan", "1e39"] {
         type_into(&mut h, "radius", text);
         assert_eq!(
-            sphere_radius(&h.state().doc.scene),
+            sphere_radius(&h.state().doc().scene),
             1.0,
             "{text} was stored as the radius"
         );
@@ -1596,12 +1612,32 @@ fn typing_nan_or_1e39_into_a_number_field_is_refused_beside_the_field() {
     }
     type_into(&mut h, "radius", "0.5");
     assert_eq!(
-        sphere_radius(&h.state().doc.scene),
+        sphere_radius(&h.state().doc().scene),
         0.5,
         "a valid value still goes in"
     );
     ctrl_s(&mut h);
     assert_eq!(sphere_radius(&reopened(&path)), 0.5);
+}
+
+#[test]
+fn a_camera_angle_of_180_is_refused_beside_the_angle_not_clamped() {
+    // The inspector has no limits of its own: the rules judge the angle, and say why beside it.
+    let path = temp_dir("angle180").join("perspective.txt");
+    let text = perspective_sphere_scene("Translate 0 0 0");
+    std::fs::write(&path, text).expect("write");
+    let mut h = harness(Some(path), (16, 16));
+    settle(&mut h);
+    select_row(&mut h, "Camera (perspective)");
+    type_into(&mut h, "angle (degrees)", "180");
+    let angle = |h: &Harness<'static, TracelabApp>| match h.state().doc().scene.camera {
+        tracelab_core::Camera::Perspective { angle, .. } => angle,
+        _ => panic!("a perspective camera"),
+    };
+    assert_eq!(angle(&h), 30.0, "180 was stored");
+    let _ = h.get_by_label("PerspectiveCamera: angle must be between 0 and 180 degrees, found 180");
+    type_into(&mut h, "angle (degrees)", "179.5");
+    assert_eq!(angle(&h), 179.5, "a valid angle past the old clamp goes in");
 }
 
 #[test]
@@ -1648,7 +1684,7 @@ fn a_camera_direction_parallel_to_up_is_refused_and_the_saved_file_opens() {
     type_into(&mut h, "direction z", "0");
     let _ = h.get_by_label("OrthographicCamera: up must not be zero or parallel to direction");
     assert_eq!(
-        h.state().doc.scene.camera.direction(),
+        h.state().doc().scene.camera.direction(),
         Vec3::new(0.0, 1.0, -1.0),
         "the last valid direction"
     );
@@ -1669,7 +1705,7 @@ fn a_zero_light_direction_is_refused_and_the_saved_file_opens() {
     }
     let _ = h.get_by_label("DirectionalLight: direction must not be zero");
     assert_eq!(
-        h.state().doc.scene.lights()[0].direction(),
+        h.state().doc().scene.lights()[0].direction(),
         Some(Vec3::new(0.0, 0.0, -1.0))
     );
     ctrl_s(&mut h);

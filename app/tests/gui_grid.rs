@@ -13,6 +13,7 @@ use egui::vec2;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::{UVec3, Vec3};
+use tracelab::gui::command::AppCommand;
 use tracelab::gui::grid_view::{GridSettings, box_path};
 use tracelab::gui::ray_diagram::{Role, Shape};
 use tracelab::gui::{AppOptions, TracelabApp};
@@ -97,10 +98,10 @@ fn the_grid_menu_renders_through_the_grid_and_shows_the_visualize_grid_picture()
 
     click_in_grid_menu(&mut h, "Render through a uniform grid (-grid)");
     assert_eq!(
-        h.state().grid.request().map(|g| g.cells),
+        h.state().grid().request().map(|g| g.cells),
         Some([10, 10, 10])
     );
-    let p = h.state().worker.with_published(|p| {
+    let p = h.state().worker().with_published(|p| {
         p.map(|p| {
             (
                 p.compiled.grid().map(|g| g.grid.cells),
@@ -132,7 +133,7 @@ fn the_grid_menu_renders_through_the_grid_and_shows_the_visualize_grid_picture()
 
     // Off again: the render comes back.
     click_in_grid_menu(&mut h, "Render through a uniform grid (-grid)");
-    assert_eq!(h.state().grid.request(), None);
+    assert_eq!(h.state().grid().request(), None);
     assert_eq!(shown(&h), bvh);
 }
 
@@ -174,7 +175,7 @@ fn a_grid_the_core_refuses_is_said_and_the_view_renders_through_the_bvh() {
     };
     let error = |h: &Harness<'static, TracelabApp>| {
         h.state()
-            .worker
+            .worker()
             .with_published(|p| p.and_then(|p| p.grid_error.clone()))
     };
     // Positive control: 16³ is built and its cells are on show.
@@ -253,8 +254,8 @@ fn the_ray_panel_lists_and_draws_the_cells_the_picked_ray_walks() {
     // Positive control: without a grid, a pick has no walk.
     h.state_mut().inspect(0, x, row);
     settle(&mut h);
-    assert!(h.state().story.is_some());
-    assert_eq!(h.state().grid_pick, None);
+    assert!(h.state().story().is_some());
+    assert_eq!(h.state().grid_pick(), None);
 
     let cells = [7u32, 5, 6];
     h.state_mut()
@@ -265,12 +266,12 @@ fn the_ray_panel_lists_and_draws_the_cells_the_picked_ray_walks() {
         }));
     settle(&mut h);
     h.state_mut().inspect(0, x, row);
-    h.state_mut().ray_panel_open = true;
+    h.state_mut().queue(AppCommand::ShowRayPanel(true));
     settle(&mut h);
     let pick = h
         .state()
-        .grid_pick
-        .clone()
+        .grid_pick()
+        .cloned()
         .expect("a walk through the grid");
 
     // Independently: the grid's box from the library's grid, the ray from the camera, the
@@ -364,16 +365,16 @@ fn a_ray_that_walks_the_grid_and_hits_nothing_still_has_its_walk_drawn() {
         })
         .expect("a ray through the grid that misses every triangle");
     h.state_mut().inspect(0, x, row);
-    h.state_mut().ray_panel_open = true;
+    h.state_mut().queue(AppCommand::ShowRayPanel(true));
     settle(&mut h);
-    let story = h.state().story.as_ref().map(|(s, _)| s.hit.is_some());
+    let story = h.state().story().map(|(s, _)| s.hit.is_some());
     assert_eq!(
         story,
         Some(false),
         "pixel ({x}, {row}): {:?}",
-        h.state().grid_pick
+        h.state().grid_pick()
     );
-    let pick = h.state().grid_pick.clone().expect("a walk");
+    let pick = h.state().grid_pick().cloned().expect("a walk");
     assert!(!pick.hit);
     assert_eq!(pick.walk, cells);
     let said = h.get_by_label_contains("hits nothing in the grid");

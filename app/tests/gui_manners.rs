@@ -44,7 +44,7 @@ fn sheared(tag: &str) -> PathBuf {
 
 /// The Transforms in file order, with their first op's translation.
 fn transforms(app: &TracelabApp) -> Vec<(NodeId, Vec3)> {
-    app.doc
+    app.doc()
         .scene
         .graph
         .iter()
@@ -59,7 +59,7 @@ fn transforms(app: &TracelabApp) -> Vec<(NodeId, Vec3)> {
 }
 
 fn translate_x(app: &TracelabApp, id: NodeId) -> f32 {
-    match &app.doc.scene.graph.node(id).kind {
+    match &app.doc().scene.graph.node(id).kind {
         NodeKind::Transform(ops) => match ops[0] {
             TransformOp::Translate(t) => t.x,
             _ => panic!("not a Translate"),
@@ -79,13 +79,13 @@ fn prepared(tag: &str) -> Harness<'static, TracelabApp> {
             index: 0,
             op: TransformOp::Translate(Vec3::new(x, t.y, t.z)),
         });
-        h.state_mut().doc.end_gesture();
+        h.state_mut().doc_mut().end_gesture();
     }
-    h.state_mut().doc.undo();
-    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.state_mut().doc_mut().undo();
+    h.state_mut().doc_mut().select(Some(Selection::Node(id)));
     h.step();
     h.step();
-    assert!(h.state().doc.can_undo() && h.state().doc.can_redo() && h.state().doc.is_dirty());
+    assert!(h.state().doc().can_undo() && h.state().doc().can_redo() && h.state().doc().is_dirty());
     h
 }
 
@@ -93,12 +93,12 @@ fn prepared(tag: &str) -> Harness<'static, TracelabApp> {
 fn fingerprint(app: &TracelabApp) -> String {
     format!(
         "{} {} {} {:?} {:?} {:?} {:?}",
-        app.doc.generation,
-        app.doc.is_dirty(),
-        app.doc.can_undo(),
-        app.doc.selection,
-        app.dialog.as_ref().map(|d| d.purpose),
-        app.confirm,
+        app.doc().generation,
+        app.doc().is_dirty(),
+        app.doc().can_undo(),
+        app.doc().selection,
+        app.dialog().map(|d| d.purpose),
+        app.confirm(),
         app.dialog_up(),
     )
 }
@@ -158,7 +158,7 @@ fn no_shortcut_reaches_the_scene_behind_the_open_dialog() {
 fn no_shortcut_reaches_the_scene_behind_the_unsaved_changes_question() {
     nothing_reaches_the_scene_behind(Dialog::Confirm, |h| {
         press(h, &KeyboardShortcut::new(Modifiers::COMMAND, egui::Key::N));
-        assert_eq!(h.state().confirm, Some(Pending::New));
+        assert_eq!(h.state().confirm(), Some(&Pending::New));
     });
 }
 
@@ -167,7 +167,7 @@ fn first_transform(tag: &str) -> (Harness<'static, TracelabApp>, NodeId) {
     let mut h = harness(sheared(tag));
     let (id, t) = transforms(h.state())[0];
     assert_eq!(t.x, -1.2);
-    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.state_mut().doc_mut().select(Some(Selection::Node(id)));
     h.step();
     h.step();
     (h, id)
@@ -187,11 +187,11 @@ fn focus_and_type(h: &mut Harness<'static, TracelabApp>, label: &str, text: &str
 #[test]
 fn a_typed_number_is_applied_on_enter_as_one_undo_step() {
     let (mut h, id) = first_transform("typed");
-    let generation = h.state().doc.generation;
+    let generation = h.state().doc().generation;
     focus_and_type(&mut h, "Translate x", "-2.75");
     // While typing nothing is applied: no half-typed value is an undo step.
     assert_eq!(translate_x(h.state(), id), -1.2);
-    assert_eq!(h.state().doc.generation, generation);
+    assert_eq!(h.state().doc().generation, generation);
     h.key_press(egui::Key::Enter);
     h.step();
     h.step();
@@ -205,7 +205,7 @@ fn a_typed_number_is_applied_on_enter_as_one_undo_step() {
         "one Ctrl+Z undoes the typed value"
     );
     assert!(
-        !h.state().doc.can_undo(),
+        !h.state().doc().can_undo(),
         "no steps left for half-typed values"
     );
 }
@@ -230,8 +230,8 @@ fn esc_in_a_number_field_restores_the_value_from_before() {
         h.step();
     }
     assert_eq!(translate_x(h.state(), id), -1.2);
-    assert!(!h.state().doc.can_undo());
-    assert!(!h.state().doc.is_dirty());
+    assert!(!h.state().doc().can_undo());
+    assert!(!h.state().doc().is_dirty());
 }
 
 /// Where the things a user clicks next are: the inspector's heading, the tree's first row
@@ -249,7 +249,7 @@ fn layout(h: &Harness<'static, TracelabApp>) -> Vec<egui::Rect> {
 fn notices_are_typed_counted_once_and_never_move_the_layout() {
     use tracelab::document::notice::Level;
     let mut h = harness(sheared("notices"));
-    h.state_mut().doc.select(None);
+    h.state_mut().doc_mut().select(None);
     h.step();
     let before = layout(&h);
     assert!(!before.is_empty());
@@ -261,7 +261,7 @@ fn notices_are_typed_counted_once_and_never_move_the_layout() {
     assert_eq!(layout(&h), before, "a notice moved the layout");
     press(&mut h, &f);
     press(&mut h, &f);
-    let notices: Vec<_> = h.state().doc.messages.iter().cloned().collect();
+    let notices: Vec<_> = h.state().doc().messages.iter().cloned().collect();
     assert_eq!(notices.len(), 1, "{notices:?}");
     assert_eq!((notices[0].level, notices[0].count), (Level::Warning, 3));
     let _ = h.get_by_label_contains("(×3)");
@@ -275,7 +275,7 @@ fn notices_are_typed_counted_once_and_never_move_the_layout() {
     h.step();
     let last = h
         .state()
-        .doc
+        .doc()
         .messages
         .iter()
         .last()
@@ -290,7 +290,7 @@ fn notices_are_typed_counted_once_and_never_move_the_layout() {
     h.get_by_label("Dismiss all").click();
     h.step();
     h.step();
-    assert!(h.state().doc.messages.is_empty());
+    assert!(h.state().doc().messages.is_empty());
     assert_eq!(layout(&h), before);
 }
 
@@ -306,7 +306,7 @@ fn the_file_changed_question_never_moves_the_layout() {
         index: 0,
         op: TransformOp::Translate(Vec3::new(2.0, t.y, t.z)),
     });
-    h.state_mut().doc.end_gesture();
+    h.state_mut().doc_mut().end_gesture();
     settle(&mut h);
     let before = layout(&h);
     // Someone edits the file beside the app.
@@ -314,7 +314,7 @@ fn the_file_changed_question_never_moves_the_layout() {
     let text = std::fs::read_to_string(&path).expect("read");
     std::fs::write(&path, format!("{text}\n# edited elsewhere\n")).expect("write");
     let start = std::time::Instant::now();
-    while !h.state().disk_changed {
+    while !h.state().disk_changed() {
         h.step();
         assert!(
             start.elapsed() < std::time::Duration::from_secs(5),
@@ -331,7 +331,7 @@ fn the_file_changed_question_never_moves_the_layout() {
     h.get_by_label("Keep mine").click();
     h.step();
     h.step();
-    assert!(!h.state().disk_changed && h.state().doc.is_dirty());
+    assert!(!h.state().disk_changed() && h.state().doc().is_dirty());
     assert!(h.query_by_label_contains("changed on disk").is_none());
     assert_eq!(translate_x(h.state(), id), 2.0);
     assert_eq!(layout(&h), before);
@@ -346,7 +346,7 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
         .with_max_steps(10_000)
         .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
     settle(&mut h);
-    assert!(!h.state().pixel_inspector_open);
+    assert!(!h.state().pixel_inspector_open());
     let (w, rows) = {
         let s = &h.state().shown()[0];
         (s.image.size[0] as u32, s.image.size[1] as u32)
@@ -354,10 +354,10 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
     // High in the image, where scaling the row would land far from it.
     let (x, row) = (w / 2, rows / 6);
     h.state_mut().inspect(0, x, row);
-    let (picked, _) = h.state().story.clone().expect("a story");
+    let (picked, _) = h.state().story().cloned().expect("a story");
     let before = h.state().shown()[0].rect;
     settle(&mut h);
-    assert!(h.state().pixel_inspector_open);
+    assert!(h.state().pixel_inspector_open());
     let after = h.state().shown()[0].rect;
     // The dock took the bottom of the view (the positive control)…
     assert!(
@@ -367,7 +367,7 @@ fn a_pick_still_describes_the_clicked_pixel_after_the_dock_shrinks_the_view() {
     // …and the picture kept its size and place: only its bottom is hidden.
     assert_eq!(after.min, before.min);
     assert_eq!(h.state().shown()[0].image.size[1] as u32, rows);
-    let (now, _) = h.state().story.clone().expect("a story");
+    let (now, _) = h.state().story().cloned().expect("a story");
     let pixel_size = 5.0 / w.max(rows) as f32 * 1.5; // the built-in camera spans about 5 units
     let moved = (now.world_ray.origin - picked.world_ray.origin).length()
         + (now.world_ray.direction - picked.world_ray.direction).length() * 10.0;
@@ -395,11 +395,11 @@ fn open_recent_keeps_canonical_paths() {
     // Named through "..", as a relative path from the working folder would be.
     assert!(app.open_now(&sub.join("..").join("sub").join("s.txt")));
     let want = std::fs::canonicalize(&file).expect("canonical");
-    assert_eq!(app.recent, vec![want.clone()]);
+    assert_eq!(app.recent(), vec![want.clone()]);
     assert!(want.is_absolute());
     // The same file by another name is one entry.
     assert!(app.open_now(&file));
-    assert_eq!(app.recent, vec![want]);
+    assert_eq!(app.recent(), vec![want]);
 }
 
 /// Bug 4: double-clicking a folder in the built-in Open dialog enters it and opens nothing
@@ -421,7 +421,10 @@ fn double_clicking_a_folder_in_the_open_dialog_enters_it_and_opens_nothing() {
         .with_max_steps(10_000)
         .build_eframe(|cc| TracelabApp::new(Some(cc), AppOptions::default()));
     settle(&mut h);
-    h.state_mut().dialog = Some(FileDialog::new(Purpose::Open, Some(&dir.join("x.txt"))));
+    h.state_mut().set_dialog(Some(FileDialog::new(
+        Purpose::Open,
+        Some(&dir.join("x.txt")),
+    )));
     h.step();
     h.step();
     // The harness steps a quarter second a frame: allow for that between the two clicks.
@@ -444,8 +447,8 @@ fn double_clicking_a_folder_in_the_open_dialog_enters_it_and_opens_nothing() {
     }
     // The positive control: the folder was entered (its scene is listed).
     let _ = h.get_by_label("a_scene.txt");
-    assert!(h.state().dialog.is_some(), "the dialog closed");
-    assert_eq!(h.state().doc.path, None, "a scene was opened");
+    assert!(h.state().dialog().is_some(), "the dialog closed");
+    assert_eq!(h.state().doc().path, None, "a scene was opened");
     assert!(!h.state().is_loading(), "a scene is being opened");
 }
 
@@ -474,11 +477,11 @@ fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
     ];
     for (i, answer, applied) in cases {
         let mut h = prepared("lecture");
-        let view = format!("{:?}", h.state().view);
-        let scene = h.state().doc.scene.clone();
+        let view = format!("{:?}", h.state().view());
+        let scene = h.state().doc().scene.clone();
         h.state_mut().queue(AppCommand::OpenLecture(i));
         let start = std::time::Instant::now();
-        while h.state().confirm.is_none() {
+        while h.state().confirm().is_none() {
             h.step();
             assert!(start.elapsed().as_secs() < 30, "never asked");
         }
@@ -490,15 +493,15 @@ fn cancelling_a_lecture_figure_leaves_the_view_and_caption_as_they_were() {
         }
         settle(&mut h);
         let app = h.state();
-        assert_eq!(app.lecture.is_some(), applied, "{answer}");
+        assert_eq!(app.lecture().is_some(), applied, "{answer}");
         let f = &FIGURES[i];
-        let shown = app.view.compare == f.compare
-            && app.view.secondary == f.secondary
-            && app.view.shade_back == f.shade_back;
+        let shown = app.view().compare == f.compare
+            && app.view().secondary == f.secondary
+            && app.view().shade_back == f.shade_back;
         assert_eq!(shown, applied, "{} {answer}", f.file);
         if !applied {
-            assert_eq!(format!("{:?}", app.view), view);
-            assert_eq!(app.doc.scene, scene);
+            assert_eq!(format!("{:?}", app.view()), view);
+            assert_eq!(app.doc().scene, scene);
         }
     }
 }
@@ -542,7 +545,7 @@ fn a_render_thread_that_could_not_start_is_shown() {
         h.query_by_label_contains("cannot start the renderer")
             .is_none()
     );
-    h.state_mut().worker =
+    *h.state_mut().worker_mut() =
         tracelab::render_worker::RenderWorker::failed_to_start("Resource temporarily unavailable");
     for _ in 0..3 {
         h.step();
@@ -555,17 +558,17 @@ fn a_render_thread_that_could_not_start_is_shown() {
 #[test]
 fn the_first_selection_does_not_shift_the_tree() {
     let mut h = harness(sheared("tree-shift"));
-    h.state_mut().doc.select(None);
+    h.state_mut().doc_mut().select(None);
     h.step();
     h.step();
     let row = |h: &Harness<'static, TracelabApp>| h.get_by_label("Background").rect();
     let before = row(&h);
     let (id, _) = transforms(h.state())[1];
-    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.state_mut().doc_mut().select(Some(Selection::Node(id)));
     h.step();
     h.step();
     // The positive control: the selection took (its buttons are enabled).
-    assert_eq!(h.state().doc.selection, Some(Selection::Node(id)));
+    assert_eq!(h.state().doc().selection, Some(Selection::Node(id)));
     assert_eq!(row(&h), before);
 }
 
@@ -582,7 +585,7 @@ fn selecting_a_material_does_not_widen_the_inspector() {
     };
     let picture = |h: &Harness<'static, TracelabApp>| h.state().shown()[0].rect;
     let (before, view) = (edge(&h), picture(&h));
-    h.state_mut().doc.select(Some(Selection::Material(1)));
+    h.state_mut().doc_mut().select(Some(Selection::Material(1)));
     for _ in 0..3 {
         h.step();
     }

@@ -48,7 +48,7 @@ fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
 }
 
 fn select(h: &mut Harness<'static, TracelabApp>, s: Selection) {
-    h.state_mut().doc.select(Some(s));
+    h.state_mut().doc_mut().select(Some(s));
     for _ in 0..3 {
         h.step();
     }
@@ -79,7 +79,7 @@ fn undo(h: &mut Harness<'static, TracelabApp>) {
 }
 
 fn material(h: &Harness<'static, TracelabApp>, i: usize) -> tracelab_core::Material {
-    h.state().doc.scene.materials[i].clone()
+    h.state().doc().scene.materials[i].clone()
 }
 
 #[test]
@@ -166,7 +166,7 @@ fn a_negative_exponent_and_a_zero_index_are_refused_with_the_reason_beside_the_f
 fn view(h: &Harness<'static, TracelabApp>) -> OnScreen {
     let shown = h.state().shown();
     let s = shown.first().expect("an image on screen");
-    let camera = h.state().doc.scene.camera.clone();
+    let camera = h.state().doc().scene.camera.clone();
     OnScreen::new(&camera, s.size()[0] as u32, s.size()[1] as u32, s.rect)
 }
 
@@ -193,7 +193,7 @@ fn drag(h: &mut Harness<'static, TracelabApp>, from: Pos2, to: Pos2) {
 }
 
 fn position(h: &Harness<'static, TracelabApp>, i: usize) -> Vec3 {
-    match h.state().doc.scene.lights()[i].kind {
+    match h.state().doc().scene.lights()[i].kind {
         LightKind::Point { position, .. } => position,
         LightKind::Directional { .. } => panic!("light {i} is directional"),
     }
@@ -207,14 +207,14 @@ fn added_point_light(tag: &str) -> Harness<'static, TracelabApp> {
     h.get_by_label("Add point light").click();
     h.step();
     h.step();
-    assert_eq!(h.state().doc.scene.lights().len(), 3);
+    assert_eq!(h.state().doc().scene.lights().len(), 3);
     // Named apart from the directional "Light 0" in the tree.
     let _ = h.get_by_label("Light 0");
     let _ = h.get_by_label("Point light 1");
     h.get_by_label("Point light 2").click();
     h.step();
     h.step();
-    assert_eq!(h.state().doc.selection, Some(Selection::Light(2)));
+    assert_eq!(h.state().doc().selection, Some(Selection::Light(2)));
     for (axis, v) in [("x", "-1"), ("y", "1"), ("z", "2")] {
         type_into(&mut h, &format!("position {axis}"), v);
     }
@@ -227,7 +227,7 @@ fn added_point_light(tag: &str) -> Harness<'static, TracelabApp> {
 fn dragging_a_point_lights_x_arrow_moves_it_along_x_as_one_undo_step() {
     let mut h = added_point_light("drag");
     let v = view(&h);
-    let g = ViewTools::light_gizmo(&h.state().doc, &v).expect("arrows at the selected light");
+    let g = ViewTools::light_gizmo(h.state().doc(), &v).expect("arrows at the selected light");
     let p0 = position(&h, 2);
     assert_eq!(g.origin, p0);
     let grab = v.project(g.handle_point(0)).expect("visible");
@@ -248,14 +248,14 @@ fn dragging_a_point_lights_x_arrow_moves_it_along_x_as_one_undo_step() {
     assert!((moved - along * 50.0).length() < 1.0, "{moved:?}");
     undo(&mut h);
     assert_eq!(position(&h, 2), p0, "the whole drag is one undo step");
-    assert_eq!(h.state().doc.scene.lights().len(), 3);
+    assert_eq!(h.state().doc().scene.lights().len(), 3);
 }
 
 #[test]
 fn a_drag_beside_the_arrows_does_not_move_the_light() {
     let mut h = added_point_light("miss");
     let v = view(&h);
-    let g = ViewTools::light_gizmo(&h.state().doc, &v).expect("arrows at the selected light");
+    let g = ViewTools::light_gizmo(h.state().doc(), &v).expect("arrows at the selected light");
     let p0 = position(&h, 2);
     let on = v.project(g.handle_point(0)).expect("visible");
     // 30 points below the x arrow: on the picture, off every handle.
@@ -360,7 +360,7 @@ fn the_world_diagram_draws_the_ray_trees_reflected_refracted_and_shadow_rays() {
 #[test]
 fn opening_a_scene_with_mirrors_or_glass_says_where_bounces_are_set() {
     let says = |h: &Harness<'static, TracelabApp>| {
-        h.state().doc.messages.iter().any(|n| {
+        h.state().doc().messages.iter().any(|n| {
             n.text
                 .contains("View › Rays (assignments 3–4) sets the bounces")
         })

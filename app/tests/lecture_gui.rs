@@ -48,19 +48,19 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
     settle(&mut h);
     let app = h.state();
     assert!(
-        app.doc
+        app.doc()
             .path
             .as_ref()
             .is_some_and(|p| p.ends_with("depth_t.txt")),
         "{:?}",
-        app.doc.path
+        app.doc().path
     );
-    assert_eq!(app.view.object_rays, ObjectRays::NormalizedNoRescale);
-    assert_eq!(app.lecture, Some(depth_t_index()));
+    assert_eq!(app.view().object_rays, ObjectRays::NormalizedNoRescale);
+    assert_eq!(app.lecture(), Some(depth_t_index()));
     let _ = h.get_by_label_contains("the big blue sphere jumps in front");
     // The render on screen uses the rule: the centre pixel, the small red sphere in truth,
     // shows the big blue one.
-    let centre = h.state().worker.with_published(|p| {
+    let centre = h.state().worker().with_published(|p| {
         let p = p.expect("published");
         assert_eq!(p.job.settings.object_rays, ObjectRays::NormalizedNoRescale);
         let f = p.frames[0].lock();
@@ -71,9 +71,9 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
         "blue in front under the bug: {centre:?}"
     );
     // The toolbar's switch back to the lecture's rule: red in front again.
-    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    h.state_mut().view_mut().object_rays = ObjectRays::Unnormalized;
     settle(&mut h);
-    let centre = h.state().worker.with_published(|p| {
+    let centre = h.state().worker().with_published(|p| {
         p.expect("published").frames[0]
             .lock()
             .get(28, 23)
@@ -84,7 +84,7 @@ fn the_lecture_menu_opens_the_depth_t_figure_with_the_bug_on_and_its_caption() {
     // Opening another file drops the caption.
     h.state_mut().queue(AppCommand::New);
     h.step();
-    assert_eq!(h.state().lecture, None);
+    assert_eq!(h.state().lecture(), None);
 }
 
 #[test]
@@ -94,7 +94,7 @@ fn the_ray_panel_draws_both_spaces_for_the_picked_pixel_and_can_be_hidden() {
     h.state_mut()
         .queue(AppCommand::OpenLecture(depth_t_index()));
     settle(&mut h);
-    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    h.state_mut().view_mut().object_rays = ObjectRays::Unnormalized;
     settle(&mut h);
     h.state_mut().inspect(0, 28, 23);
     for _ in 0..3 {
@@ -119,23 +119,23 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     settle(&mut h);
     let (id, _) = h
         .state()
-        .doc
+        .doc()
         .scene
         .graph
         .iter()
         .find(|(_, n)| matches!(n.kind, NodeKind::Transform(_)))
         .expect("a Transform");
-    h.state_mut().doc.select(Some(Selection::Node(id)));
+    h.state_mut().doc_mut().select(Some(Selection::Node(id)));
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
     assert!(
-        h.state().animation.is_some(),
+        h.state().animation().is_some(),
         "{:?}",
-        h.state().doc.messages
+        h.state().doc().messages
     );
     let dir = std::env::temp_dir().join(format!("tracelab-lecture-gui-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let mut form = h.state().animation.clone().expect("form");
+    let mut form = h.state().animation().cloned().expect("form");
     form.frames = 3;
     form.from = 0.0;
     form.to = 1.0;
@@ -144,9 +144,9 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     let start = Instant::now();
     loop {
         h.step();
-        if h.state().animation_running.is_none()
+        if !h.state().animation_running()
             && h.state()
-                .doc
+                .doc()
                 .messages
                 .iter()
                 .any(|m| m.text.contains("animation") || m.text.contains("exported"))
@@ -161,7 +161,7 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
     }
     let msg = h
         .state()
-        .doc
+        .doc()
         .messages
         .iter()
         .last()
@@ -177,11 +177,11 @@ fn an_animation_exported_from_the_editor_writes_every_frame() {
         assert!(PathBuf::from(&dir).join(f).is_file(), "{f}");
     }
     // Without a Transform selected the dialog offers the bounce sweep only.
-    h.state_mut().doc.select(None);
-    h.state_mut().animation = None;
+    h.state_mut().doc_mut().select(None);
+    h.state_mut().set_animation(None);
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
-    let form = h.state().animation.clone().expect("the dialog");
+    let form = h.state().animation().cloned().expect("the dialog");
     assert_eq!(form.node, None);
     assert!(form.bounce_sweep);
 }
@@ -200,10 +200,10 @@ fn a_bounce_sweep_exported_from_the_editor_writes_a_frame_per_count() {
         .expect("in the menu");
     h.state_mut().queue(AppCommand::OpenLecture(i));
     settle(&mut h);
-    h.state_mut().doc.select(None);
+    h.state_mut().doc_mut().select(None);
     h.state_mut().queue(AppCommand::AnimationDialog);
     h.step();
-    let mut form = h.state().animation.clone().expect("the dialog");
+    let mut form = h.state().animation().cloned().expect("the dialog");
     assert!(form.bounce_sweep);
     assert_eq!(
         (form.bounces.from, form.bounces.to),
@@ -219,9 +219,9 @@ fn a_bounce_sweep_exported_from_the_editor_writes_a_frame_per_count() {
     let start = Instant::now();
     loop {
         h.step();
-        if h.state().animation_running.is_none()
+        if !h.state().animation_running()
             && h.state()
-                .doc
+                .doc()
                 .messages
                 .iter()
                 .any(|m| m.text.contains("exported"))
@@ -234,8 +234,8 @@ fn a_bounce_sweep_exported_from_the_editor_writes_a_frame_per_count() {
         );
         std::thread::sleep(Duration::from_millis(10));
     }
-    let scene = h.state().doc.scene.clone();
-    let view = h.state().view.secondary;
+    let scene = h.state().doc().scene.clone();
+    let view = h.state().view().secondary;
     for k in 0..3u32 {
         let frame = image::open(dir.join(format!("frame_{k:04}.png")))
             .expect("frame")
@@ -274,8 +274,8 @@ fn a_bounce_figure_opens_with_its_rays_and_a_plain_figure_puts_them_back() {
             .expect("in the menu");
         h.state_mut().queue(AppCommand::OpenLecture(i));
         settle(&mut h);
-        let view = &h.state().view;
-        assert_eq!(h.state().lecture, Some(i), "{file}");
+        let view = &h.state().view();
+        assert_eq!(h.state().lecture(), Some(i), "{file}");
         assert!(view.shade_back, "{file}");
         assert!(view.secondary.shadows, "{file}");
         assert_eq!(view.secondary.weight, 0.01, "{file}");
@@ -284,15 +284,15 @@ fn a_bounce_figure_opens_with_its_rays_and_a_plain_figure_puts_them_back() {
         let _ = h.get_by_label_contains(&format!("View › Rays: step the bounces from 0 to {last}"));
         let job = h
             .state()
-            .worker
+            .worker()
             .with_published(|p| p.map(|p| (p.job.settings.secondary, p.job.settings.shade_back)));
-        assert_eq!(job, Some((h.state().view.secondary, true)), "{file}");
+        assert_eq!(job, Some((h.state().view().secondary, true)), "{file}");
     }
     h.state_mut()
         .queue(AppCommand::OpenLecture(depth_t_index()));
     settle(&mut h);
-    assert_eq!(h.state().view.secondary, Secondary::NONE);
-    assert!(!h.state().view.shade_back);
+    assert_eq!(h.state().view().secondary, Secondary::NONE);
+    assert!(!h.state().view().shade_back);
 }
 
 /// Pixels of `s`'s shown part that are the sheared sphere's red and the box's green.
@@ -362,7 +362,7 @@ fn the_normal_transform_figure_shows_each_object_under_both_rules() {
         for _ in 0..3 {
             h.step();
         }
-        let at = h.state().inspected.clone().expect("a pixel inspected");
+        let at = h.state().inspected().cloned().expect("a pixel inspected");
         assert_eq!(at.frame, frame, "clicked at {c:?}");
     }
 }
@@ -404,7 +404,7 @@ fn the_ray_diagrams_can_be_big_and_their_labels_never_overlap() {
     h.state_mut()
         .queue(AppCommand::OpenLecture(depth_t_index()));
     settle(&mut h);
-    h.state_mut().view.object_rays = ObjectRays::Unnormalized;
+    h.state_mut().view_mut().object_rays = ObjectRays::Unnormalized;
     settle(&mut h);
     h.state_mut().inspect(0, 28, 23);
     for _ in 0..3 {
@@ -432,7 +432,7 @@ fn the_ray_diagrams_can_be_big_and_their_labels_never_overlap() {
     for _ in 0..3 {
         h.step();
     }
-    assert!(!h.state().ray_window);
+    assert!(!h.state().ray_window());
     let again = h.get_by_label("World space diagram").rect();
     assert!(again.width() < 250.0, "docked again: {again:?}");
 }

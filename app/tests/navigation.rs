@@ -59,7 +59,7 @@ fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
 }
 
 fn camera(h: &Harness<'static, TracelabApp>) -> Camera {
-    h.state().doc.scene.camera.clone()
+    h.state().doc().scene.camera.clone()
 }
 
 /// The image on screen, as the view draws it, with the document's camera.
@@ -103,7 +103,7 @@ fn drag(
 }
 
 fn node_where(h: &Harness<'static, TracelabApp>, f: impl Fn(&NodeKind) -> bool) -> NodeId {
-    let g = &h.state().doc.scene.graph;
+    let g = &h.state().doc().scene.graph;
     g.preorder()
         .into_iter()
         .find(|&id| f(&g.node(id).kind))
@@ -207,7 +207,7 @@ fn an_orbit_drag_is_one_undo_step_that_restores_the_exact_camera_and_save_writes
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert_eq!(camera(&h), before, "one undo returns the exact camera");
-    assert!(!h.state().doc.can_undo(), "the whole drag was one step");
+    assert!(!h.state().doc().can_undo(), "the whole drag was one step");
 }
 
 #[test]
@@ -227,7 +227,7 @@ fn alt_left_drag_orbits_too_and_shift_middle_drag_pans_with_the_pointer() {
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     settle(&mut h);
     assert!((angle_between(before.direction(), camera(&h).direction()) - 20.0).abs() < 0.05);
-    h.state_mut().doc.undo();
+    h.state_mut().doc_mut().undo();
     settle(&mut h);
     // Pan: the sphere's front follows the pointer.
     let v = view(&h);
@@ -322,7 +322,7 @@ fn f_frames_the_selection_home_frames_all_and_7_looks_down() {
     let objects = "Transform { Translate 6 3 -4 Sphere { center 0 0 0 radius 0.5 } }";
     let mut h = harness(scene_file("frame", objects, PERSPECTIVE));
     let s = sphere(&h);
-    let bounds = tracelab::bounds::world_bounds(&h.state().doc.scene, s).expect("bounded");
+    let bounds = tracelab::bounds::world_bounds(&h.state().doc().scene, s).expect("bounded");
     assert!(
         !inside_the_image(&h, bounds),
         "the test needs the sphere out of view at first"
@@ -358,8 +358,8 @@ fn f_frames_the_selection_home_frames_all_and_7_looks_down() {
         "keeps the camera type"
     );
     assert_eq!((c.direction(), c.up()), (Vec3::NEG_Y, Vec3::NEG_Z));
-    let root = h.state().doc.scene.graph.root();
-    let all = tracelab::bounds::world_bounds(&h.state().doc.scene, root).expect("bounded");
+    let root = h.state().doc().scene.graph.root();
+    let all = tracelab::bounds::world_bounds(&h.state().doc().scene, root).expect("bounded");
     assert!(inside_the_image(&h, all));
 }
 
@@ -383,7 +383,7 @@ fn red_centroid(h: &Harness<'static, TracelabApp>) -> glam::Vec2 {
 
 fn gizmo_point(h: &Harness<'static, TracelabApp>, handle: Handle) -> Pos2 {
     let v = view(h);
-    let g = ViewTools::gizmo(&h.state().doc, &v, Axes::World).expect("a gizmo for the selection");
+    let g = ViewTools::gizmo(h.state().doc(), &v, Axes::World).expect("a gizmo for the selection");
     v.project(g.handle_point(handle)).expect("visible")
 }
 
@@ -393,7 +393,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     let s = sphere(&h);
     select(&mut h, s);
     let v = view(&h);
-    let centre = tracelab::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
+    let centre = tracelab::bounds::world_centre(&h.state().doc().scene, s).expect("centre");
     let c0 = v.project(centre).expect("visible");
     let drawn0 = red_centroid(&h);
     let grab = gizmo_point(&h, Handle::Move(0));
@@ -410,10 +410,10 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     settle(&mut h);
     let NodeKind::Transform(ops) = &h
         .state()
-        .doc
+        .doc()
         .scene
         .graph
-        .node(h.state().doc.scene.graph.parents()[s.index()].expect("parent"))
+        .node(h.state().doc().scene.graph.parents()[s.index()].expect("parent"))
         .kind
     else {
         panic!("the sphere's parent is still its Transform")
@@ -422,7 +422,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
         panic!("{ops:?}")
     };
     assert_eq!((t.y, t.z), (0.0, 0.0), "only x moves");
-    let centre1 = tracelab::bounds::world_centre(&h.state().doc.scene, s).expect("centre");
+    let centre1 = tracelab::bounds::world_centre(&h.state().doc().scene, s).expect("centre");
     let c1 = view(&h).project(centre1).expect("visible");
     let moved = c1 - c0;
     assert!(
@@ -446,7 +446,7 @@ fn a_translate_arrow_drag_moves_the_object_with_the_pointer_under_a_uniform_scal
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert_eq!(
-        tracelab::bounds::world_centre(&h.state().doc.scene, s),
+        tracelab::bounds::world_centre(&h.state().doc().scene, s),
         Some(centre)
     );
 }
@@ -467,20 +467,15 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
         true,
     );
     settle(&mut h);
-    let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+    let t = h.state().doc().scene.graph.parents()[s.index()].expect("parent");
+    let NodeKind::Transform(ops) = &h.state().doc().scene.graph.node(t).kind else {
         panic!("a Transform")
     };
     assert!(
         matches!(ops.as_slice(), [TransformOp::Translate(v), TransformOp::Scale(_)] if v.y > 0.0 && v.x == 0.0),
         "{ops:?}"
     );
-    let note = h
-        .state()
-        .note
-        .as_ref()
-        .map(|n| n.0.clone())
-        .unwrap_or_default();
+    let note = h.state().note().map(str::to_string).unwrap_or_default();
     assert!(note.contains("added Translate as op 1"), "{note}");
     // The ring adds its ZRotate after the Translate, before the Scale.
     let grab = gizmo_point(&h, Handle::Rotate);
@@ -493,7 +488,7 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
         true,
     );
     settle(&mut h);
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+    let NodeKind::Transform(ops) = &h.state().doc().scene.graph.node(t).kind else {
         panic!("a Transform")
     };
     assert!(
@@ -504,7 +499,7 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
     let mut h = harness(scene_file("wrap", SPHERE, PERSPECTIVE));
     let s = sphere(&h);
     select(&mut h, s);
-    let before = h.state().doc.scene.clone();
+    let before = h.state().doc().scene.clone();
     let grab = gizmo_point(&h, Handle::Scale(0));
     drag(
         &mut h,
@@ -515,20 +510,15 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
         true,
     );
     settle(&mut h);
-    let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+    let t = h.state().doc().scene.graph.parents()[s.index()].expect("parent");
+    let NodeKind::Transform(ops) = &h.state().doc().scene.graph.node(t).kind else {
         panic!("wrapped in a Transform")
     };
     assert!(
         matches!(ops.as_slice(), [TransformOp::Scale(v)] if v.x > 1.0 && v.y == 1.0 && v.z == 1.0),
         "{ops:?}"
     );
-    let note = h
-        .state()
-        .note
-        .as_ref()
-        .map(|n| n.0.clone())
-        .unwrap_or_default();
+    let note = h.state().note().map(str::to_string).unwrap_or_default();
     assert!(
         note.contains("wrapped the Sphere in a new Transform with Scale"),
         "{note}"
@@ -536,7 +526,7 @@ fn a_missing_op_is_added_in_its_place_a_lone_node_is_wrapped_and_the_status_bar_
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert_eq!(
-        h.state().doc.scene,
+        h.state().doc().scene,
         before,
         "one undo takes the Transform away again"
     );
@@ -547,7 +537,7 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
     let mut h = harness(scene_file("esc", SCALED, PERSPECTIVE));
     let s = sphere(&h);
     select(&mut h, s);
-    let before = h.state().doc.scene.clone();
+    let before = h.state().doc().scene.clone();
     let grab = gizmo_point(&h, Handle::Move(0));
     drag(
         &mut h,
@@ -557,10 +547,10 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
         5,
         false,
     );
-    assert_ne!(h.state().doc.scene, before, "the drag moved it");
+    assert_ne!(h.state().doc().scene, before, "the drag moved it");
     h.key_press(egui::Key::Escape);
     h.step();
-    assert_eq!(h.state().doc.scene, before, "Esc puts it back");
+    assert_eq!(h.state().doc().scene, before, "Esc puts it back");
     // The rest of that press moves nothing.
     h.event(Event::PointerMoved(grab + vec2(80.0, 0.0)));
     h.step();
@@ -571,9 +561,9 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
         false,
     );
     settle(&mut h);
-    assert_eq!(h.state().doc.scene, before);
+    assert_eq!(h.state().doc().scene, before);
     assert!(
-        !h.state().doc.can_undo(),
+        !h.state().doc().can_undo(),
         "nothing to undo after a cancelled drag"
     );
     // With Ctrl, the Translate lands on a multiple of 0.1 (in the op's own units).
@@ -588,8 +578,8 @@ fn esc_during_a_gizmo_drag_restores_the_value_and_ctrl_snaps() {
     );
     h.event(Event::ModifiersChanged(Modifiers::NONE));
     settle(&mut h);
-    let t = h.state().doc.scene.graph.parents()[s.index()].expect("parent");
-    let NodeKind::Transform(ops) = &h.state().doc.scene.graph.node(t).kind else {
+    let t = h.state().doc().scene.graph.parents()[s.index()].expect("parent");
+    let NodeKind::Transform(ops) = &h.state().doc().scene.graph.node(t).kind else {
         panic!("a Transform")
     };
     let TransformOp::Translate(v) = ops[0] else {
@@ -613,11 +603,11 @@ fn a_drag_renders_coarse_passes_while_the_pointer_moves_and_refines_when_it_stop
         3,
         false,
     );
-    assert!(h.state().worker.coarse_only, "moving: coarse passes only");
+    assert!(h.state().worker().coarse_only, "moving: coarse passes only");
     let start = Instant::now();
     while !h
         .state()
-        .worker
+        .worker()
         .with_published(|p| p.is_some_and(|p| p.job.coarse && p.full.is_some()))
     {
         h.step();
@@ -626,7 +616,7 @@ fn a_drag_renders_coarse_passes_while_the_pointer_moves_and_refines_when_it_stop
     // Held still: the same camera is rendered in full, before the button is even released.
     std::thread::sleep(tracelab::gui::view_tools::STILL_AFTER);
     settle(&mut h);
-    h.state().worker.with_published(|p| {
+    h.state().worker().with_published(|p| {
         let p = p.expect("published");
         // Four passes, or fewer where a quick coarse pass went straight to the full one.
         assert!(
@@ -636,7 +626,7 @@ fn a_drag_renders_coarse_passes_while_the_pointer_moves_and_refines_when_it_stop
                 && p.passes_done == p.passes,
             "refined"
         );
-        assert_eq!(p.job.generation, h.state().doc.generation);
+        assert_eq!(p.job.generation, h.state().doc().generation);
     });
     press(&mut h, PointerButton::Middle, from + vec2(30.0, 0.0), false);
 }

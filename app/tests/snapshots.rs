@@ -32,11 +32,11 @@ fn settled_harness() -> Harness<'static, TracelabApp> {
                     ..AppOptions::default()
                 },
             );
-            app.show_timings = false;
+            app.set_show_timings(false);
             app
         });
     let start = Instant::now();
-    while !h.state().worker.is_idle() {
+    while !h.state().worker().is_idle() {
         h.step();
         assert!(
             start.elapsed() < Duration::from_secs(60),

@@ -102,7 +102,7 @@ fn each_view_tab_shows_what_the_command_line_renders() {
     let scene = scene_file("tabs", SQUASHED);
     let mut h = harness(&scene, (40, 32));
     settle(&mut h);
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     let mut seen = Vec::new();
     for (tab, view) in [
         ("Normals", "normals"),
@@ -130,7 +130,7 @@ fn all_three_shows_colour_normals_and_depth_as_the_command_line_renders_them() {
     let mut h = harness(&scene, (36, 36));
     settle(&mut h);
     click(&mut h, "All three");
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     let s = shown(&h);
     assert_eq!(s.len(), 3);
     for (s, view) in s.iter().zip(["color", "normals", "depth"]) {
@@ -149,7 +149,7 @@ fn the_normal_switch_shows_each_rule_as_the_command_line_renders_it() {
     let scene = scene_file("switch", SQUASHED);
     let mut h = harness(&scene, (40, 40));
     settle(&mut h);
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     for (tab, view) in [("Normals", "normals"), ("Colour", "color")] {
         click(&mut h, tab);
         let correct = single(&h).rgb8();
@@ -193,11 +193,11 @@ fn shade_back_shows_what_the_command_line_renders_with_shade_back() {
     let scene = scene_file("shade-back", INSIDE);
     let mut h = harness(&scene, (40, 40));
     settle(&mut h);
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     let off = single(&h).rgb8();
     assert_eq!(off, cli(&scene, [40, 40], "color", depth, &[]));
     click(&mut h, "shade back");
-    assert!(h.state().view.shade_back);
+    assert!(h.state().view().shade_back);
     let on = single(&h).rgb8();
     assert_ne!(on, off, "shade back changed nothing on screen");
     assert_eq!(on, cli(&scene, [40, 40], "color", depth, &["--shade-back"]));
@@ -217,7 +217,7 @@ fn the_depth_range_maps_depth_as_the_command_line_does() {
     h.get_by_label("max").set_value_accesskit(10.5);
     h.step();
     settle(&mut h);
-    assert_eq!(h.state().view.depth, (9.0, 10.5));
+    assert_eq!(h.state().view().depth, (9.0, 10.5));
     let after = single(&h).rgb8();
     assert_ne!(
         after, before,
@@ -231,7 +231,7 @@ fn fixed_size_renders_the_size_asked_for_and_off_follows_the_view() {
     let scene = scene_file("fixed", SQUASHED);
     let mut h = harness(&scene, (40, 40));
     settle(&mut h);
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     h.get_by_label("w").set_value_accesskit(30.0);
     h.step();
     settle(&mut h);
@@ -239,7 +239,7 @@ fn fixed_size_renders_the_size_asked_for_and_off_follows_the_view() {
     assert_eq!(s.size(), [30, 40]);
     assert_eq!(s.rgb8(), cli(&scene, [30, 40], "color", depth, &[]));
     click(&mut h, "fixed size");
-    assert_eq!(h.state().view.fixed_size, None);
+    assert_eq!(h.state().view().fixed_size, None);
     let s = single(&h);
     let [w, hh] = s.size();
     assert!(w > 200 && hh > 200, "the render follows the view: {w}×{hh}");
@@ -270,7 +270,7 @@ fn side_by_side_shows_both_rules_as_the_command_line_renders_them() {
     settle(&mut h);
     click(&mut h, "Normals");
     choose_compare(&mut h, "side by side");
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     let s = shown(&h);
     assert_eq!(s.len(), 2);
     assert_eq!(
@@ -305,7 +305,7 @@ fn split_shows_the_correct_rule_left_of_the_line_and_the_incorrect_right() {
     settle(&mut h);
     click(&mut h, "Normals");
     choose_compare(&mut h, "split");
-    let depth = h.state().view.depth;
+    let depth = h.state().view().depth;
     let s = shown(&h);
     assert_eq!(s.len(), 2, "two halves");
     assert_eq!(
@@ -447,7 +447,7 @@ fn badges_over_the_object(h: &Harness<'static, TracelabApp>) -> Vec<egui::Rect> 
             let px =
                 |p: egui::Pos2| (p - s.rect.min) / s.rect.size() * egui::vec2(w as f32, hh as f32);
             let (a, z) = (px(b.min), px(b.max));
-            app.worker.with_published(|p| {
+            app.worker().with_published(|p| {
                 let f = p.expect("published").frames[0].lock();
                 (a.y.max(0.0) as u32..(z.y.ceil() as u32).min(hh as u32)).any(|row| {
                     (a.x.max(0.0) as u32..(z.x.ceil() as u32).min(w as u32))

@@ -28,7 +28,7 @@ pub use render::{
     compile, render_frame,
 };
 pub use scene::{
-    Anchor, Background, Camera, Comments, CsgOp, DEFAULT_MATERIAL_COLOR, Graph, Invalid, Light,
-    Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId, NodeKind, Place, Problem, Scene,
-    SceneComments, SolidTexture, TextureKind, TransformOp, check_scene,
+    Anchor, Background, Camera, Comments, CsgOp, DEFAULT_MATERIAL_COLOR, Field, Graph, Invalid,
+    Light, Material, MaterialKeyword, Mesh, MeshSlot, Node, NodeId, NodeKind, Place, Problem,
+    Scene, SceneComments, SolidTexture, TextureKind, TransformOp, check_scene,
 };

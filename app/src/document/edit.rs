@@ -5,8 +5,8 @@ use super::error::Misfit;
 use super::op_target::{OpKind, op_target};
 use glam::Vec3;
 use tracelab_core::{
-    Background, Camera, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem, Scene,
-    TransformOp, check_scene,
+    Background, Camera, Field, Graph, Light, Material, Node, NodeId, NodeKind, Place, Problem,
+    Scene, TransformOp, check_scene,
 };
 
 #[derive(Clone, Debug, PartialEq)]
@@ -127,15 +127,15 @@ impl Edit {
     }
 }
 
-/// Why an edit was refused: the place and field it would have broken, as the file names
-/// them (`radius`, `direction`, `Scale`), so the inspector can show the reason beside that
-/// field, and the reason itself.
+/// Why an edit was refused: the place and field it would have broken, so the inspector can
+/// show the reason beside the widget of that [`Field`], and the reason itself.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Refusal {
     /// `None` for an edit that does not fit the scene's structure (a stale id, a move into
     /// its own subtree).
     pub place: Option<Place>,
-    pub field: String,
+    /// `None` with no place.
+    pub field: Option<Field>,
     /// For a Transform: the op at fault.
     pub op: Option<usize>,
     pub reason: String,
@@ -145,7 +145,7 @@ impl Refusal {
     fn structural(reason: String) -> Self {
         Refusal {
             place: None,
-            field: String::new(),
+            field: None,
             op: None,
             reason,
         }
@@ -154,7 +154,7 @@ impl Refusal {
     fn broken(p: &Problem) -> Self {
         Refusal {
             place: Some(p.place),
-            field: p.field.clone(),
+            field: Some(p.field.clone()),
             op: p.op,
             reason: p.reason.clone(),
         }

@@ -621,8 +621,11 @@ mod tests {
             })
             .expect_err("a space");
         assert_eq!(
-            (refused.place, refused.field.as_str()),
-            (Some(tracelab_core::Place::Node(id)), "obj_file")
+            (refused.place, refused.field),
+            (
+                Some(tracelab_core::Place::Node(id)),
+                Some(tracelab_core::Field::ObjFile)
+            )
         );
         doc.apply(Edit::SetNodeKind {
             node: id,

@@ -39,7 +39,7 @@ pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>
     let start = std::time::Instant::now();
     loop {
         h.step();
-        if h.state().worker.is_idle() && !h.state().is_loading() {
+        if h.state().worker().is_idle() && !h.state().is_loading() {
             h.step();
             return;
         }

@@ -525,8 +525,11 @@ mod tests {
         let p = try_write_scene(&bad).expect_err("a zero light direction");
         assert_eq!(p.len(), 1);
         assert_eq!(
-            (p[0].place, p[0].field.as_str()),
-            (crate::scene::Place::Light(0), "direction")
+            (p[0].place, &p[0].field),
+            (
+                crate::scene::Place::Light(0),
+                &crate::scene::Field::Direction
+            )
         );
         assert_eq!(
             p[0].message,

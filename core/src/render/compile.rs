@@ -14,12 +14,12 @@ use super::texture::CompiledTexture;
 use crate::accel::Bvh;
 use crate::geometry::{
     Aabb, Ray, Transform, box_face_normal, box_span, intersect_plane, intersect_sphere,
-    intersect_triangle, sphere_bounds, sphere_normal, triangle_normal,
+    intersect_triangle, sphere_normal,
 };
 use crate::memory::{OutOfMemory, try_with_capacity};
 use crate::scene::{
-    DEFAULT_ATTENUATION, DEFAULT_MATERIAL_COLOR, LightKind, Mesh, MeshSlot, NodeId, NodeKind,
-    Phong, Scene, Walk, unit, validate::MAX_TEXTURE_DEPTH,
+    DEFAULT_ATTENUATION, DEFAULT_MATERIAL_COLOR, LightKind, Mesh, NodeId, NodeKind, Phong, Scene,
+    Walk, unit, validate::MAX_TEXTURE_DEPTH,
 };
 
 /// A point light ready to shade with.
@@ -31,31 +31,9 @@ pub struct PointLight {
     pub attenuation: Vec3,
 }
 
-#[derive(Clone, Debug)]
-pub enum Shape {
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
-    /// `normal` is unit length: the plane is {p : normal·p = offset}.
-    Plane {
-        normal: Vec3,
-        offset: f32,
-    },
-    Triangle {
-        vertices: [Vec3; 3],
-        normal: Vec3,
-    },
-    Mesh(Arc<Mesh>),
-    /// An axis-aligned box in object space; a hit's `prim` is the face (axis·2, +1 for max).
-    Box {
-        min: Vec3,
-        max: Vec3,
-    },
-    /// A CSG subtree whose leaves carry their own world transforms and materials; a hit's
-    /// `prim` is the boundary code of `csg::CsgTree` (leaf, exit and flip bits).
-    Csg(Arc<CsgTree>),
-}
+/// An object's primitive: the description CSG's leaves share (`shape.rs`), its CSG subtree
+/// compiled.
+pub type Shape = super::shape::Shape<Arc<CsgTree>>;
 
 #[derive(Clone, Debug)]
 pub struct Object {
@@ -140,37 +118,6 @@ impl CompiledScene {
         while let Some(v) = walk.next() {
             let (id, m, material) = (v.id, v.world_from_object, v.material);
             let shape = match &v.node.kind {
-                NodeKind::Group | NodeKind::Transform(_) => continue,
-                NodeKind::Sphere { center, radius } => Shape::Sphere {
-                    center: *center,
-                    radius: *radius,
-                },
-                NodeKind::Plane { normal, offset } => {
-                    // The offset is measured along the normalised normal, as the course's
-                    // Plane does.
-                    Shape::Plane {
-                        normal: unit(*normal).unwrap_or(Vec3::Y),
-                        offset: *offset,
-                    }
-                }
-                NodeKind::Triangle {
-                    vertices: [a, b, c],
-                } => Shape::Triangle {
-                    vertices: [*a, *b, *c],
-                    normal: triangle_normal(*a, *b, *c),
-                },
-                NodeKind::TriangleMesh {
-                    mesh: MeshSlot::Loaded(mesh),
-                    ..
-                } => Shape::Mesh(mesh.clone()),
-                NodeKind::TriangleMesh {
-                    mesh: MeshSlot::Failed(_) | MeshSlot::Unresolved,
-                    ..
-                } => continue,
-                NodeKind::Box { min, max } => Shape::Box {
-                    min: *min,
-                    max: *max,
-                },
                 NodeKind::Csg(_) => {
                     // One object for the whole subtree: its leaves keep their own transforms
                     // and materials, and its bounds go into the top-level BVH.
@@ -186,6 +133,11 @@ impl CompiledScene {
                     });
                     continue;
                 }
+                // Groups and Transforms are walked through; an unloaded mesh shows nothing.
+                kind => match Shape::of_node(kind) {
+                    Some(shape) => shape,
+                    None => continue,
+                },
             };
             let xf = (m != DMat4::IDENTITY).then(|| Transform::from_f64(m));
             let material = material.filter(|&i| i < n_mat).unwrap_or(default_material);
@@ -702,13 +654,9 @@ fn lanes(mask: u8) -> impl Iterator<Item = usize> {
 
 fn object_bounds(o: &Object) -> Aabb {
     let local = match &o.shape {
-        Shape::Sphere { center, radius } => sphere_bounds(*center, *radius),
-        Shape::Plane { .. } => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
-        Shape::Triangle { vertices, .. } => Aabb::from_points(vertices),
-        Shape::Mesh(m) => m.bounds(),
-        Shape::Box { min, max } => Aabb::new(*min, *max),
         // Already in world space (the object has no transform of its own).
         Shape::Csg(tree) => return tree.bounds(),
+        shape => shape.local_bounds().unwrap_or(Aabb::EMPTY),
     };
     o.xf.as_ref().map_or(local, |xf| xf.world_bounds(local))
 }

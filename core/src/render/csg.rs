@@ -7,16 +7,17 @@
 //! so deep nesting cannot overflow the call stack.
 
 use std::cell::RefCell;
-use std::sync::Arc;
+use std::convert::Infallible;
 
 use glam::{DMat4, Vec3};
 
 use super::NormalTransform;
+use super::shape::Shape;
 use crate::accel::TriangleHit;
 use crate::geometry::{
-    Aabb, Ray, Transform, box_face_normal, box_span, sphere_bounds, sphere_normal, sphere_roots,
+    Aabb, Ray, Transform, box_face_normal, box_span, sphere_normal, sphere_roots,
 };
-use crate::scene::{CsgOp, Graph, Mesh, MeshSlot, NodeId, NodeKind, Walk, unit};
+use crate::scene::{CsgOp, Graph, NodeId, NodeKind, Walk};
 
 /// A boundary's code (also what `Hit::prim` holds for a CSG hit): the leaf index in the low
 /// bits, whether the ray leaves that leaf there, and whether the normal is flipped (a
@@ -47,32 +48,15 @@ impl Bound {
     }
 }
 
-/// A leaf's geometry in its object space.
-#[derive(Clone, Debug)]
-pub enum Solid {
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
-    Box {
-        min: Vec3,
-        max: Vec3,
-    },
-    /// The half-space behind a Plane: {p : normal·p ≤ offset}, normal unit length.
-    HalfSpace {
-        normal: Vec3,
-        offset: f32,
-    },
-    /// A closed mesh (the parser rejects open ones).
-    Mesh(Arc<Mesh>),
-    /// Something that bounds no solid (a lone Triangle, an unloaded mesh, a missing
-    /// operand in an edited scene): it contributes nothing.
-    Empty,
-}
+/// A leaf's geometry in its object space: the compiled objects' description (a Plane is the
+/// half-space behind it), never a CSG subtree (nested operations are steps of the program).
+pub type LeafShape = Shape<Infallible>;
 
 #[derive(Clone, Debug)]
 pub struct CsgLeaf {
-    pub solid: Solid,
+    /// None: something that bounds no solid (a lone Triangle, a Group, an unloaded mesh, a
+    /// missing operand in an edited scene); it contributes nothing.
+    pub solid: Option<LeafShape>,
     /// The leaf's whole world transform (Transforms above the CSG node included).
     pub xf: Option<Transform>,
     /// Index into `CompiledScene::materials`: a surface keeps its operand's material.
@@ -134,7 +118,7 @@ impl CsgTree {
         let empty = |leaves: &mut Vec<CsgLeaf>, program: &mut Vec<Step>, node: NodeId| {
             program.push(Step::Leaf(leaves.len() as u32));
             leaves.push(CsgLeaf {
-                solid: Solid::Empty,
+                solid: None,
                 xf: None,
                 material: resolve(material),
                 node,
@@ -182,26 +166,13 @@ impl CsgTree {
                     });
                     continue;
                 }
-                NodeKind::Sphere { center, radius } => Solid::Sphere {
-                    center: *center,
-                    radius: *radius,
-                },
-                NodeKind::Box { min, max } => Solid::Box {
-                    min: *min,
-                    max: *max,
-                },
-                NodeKind::Plane { normal, offset } => Solid::HalfSpace {
-                    normal: unit(*normal).unwrap_or(Vec3::Y),
-                    offset: *offset,
-                },
-                NodeKind::TriangleMesh {
-                    mesh: MeshSlot::Loaded(mesh),
-                    ..
-                } => Solid::Mesh(mesh.clone()),
                 // Groups, lone triangles and unloaded meshes bound no solid.
-                _ => {
-                    walk.skip_children();
-                    Solid::Empty
+                kind => {
+                    let solid = LeafShape::of_node(kind).filter(LeafShape::is_solid);
+                    if solid.is_none() {
+                        walk.skip_children();
+                    }
+                    solid
                 }
             };
             program.push(Step::Leaf(leaves.len() as u32));
@@ -344,18 +315,17 @@ fn program_bounds(program: &[Step], leaves: &[CsgLeaf]) -> Aabb {
 
 fn leaf_world_bounds(leaf: &CsgLeaf) -> Aabb {
     let local = match &leaf.solid {
-        Solid::Sphere { center, radius } => sphere_bounds(*center, *radius),
-        Solid::Box { min, max } => Aabb::new(*min, *max),
-        Solid::HalfSpace { .. } => return Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
-        Solid::Mesh(m) => m.bounds(),
-        Solid::Empty => return Aabb::EMPTY,
+        // A half-space stays unbounded whatever moves it.
+        Some(Shape::Plane { .. }) => return Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+        Some(shape) => shape.local_bounds().unwrap_or(Aabb::EMPTY),
+        None => return Aabb::EMPTY,
     };
     leaf.xf.as_ref().map_or(local, |xf| xf.world_bounds(local))
 }
 
 /// Appends a leaf's sorted boundaries along the whole (object-space) ray.
 fn leaf_bounds(
-    solid: &Solid,
+    solid: &Option<LeafShape>,
     r: &Ray,
     leaf: u32,
     out: &mut Vec<Bound>,
@@ -370,17 +340,17 @@ fn leaf_bounds(
     };
     let (enter, exit) = (leaf, leaf | EXIT_BIT);
     match solid {
-        Solid::Sphere { center, radius } => {
+        Some(Shape::Sphere { center, radius }) => {
             if let Some((t0, t1)) = sphere_roots(r, *center, *radius) {
                 span(t0, enter, t1, exit);
             }
         }
-        Solid::Box { min, max } => {
+        Some(Shape::Box { min, max }) => {
             if let Some((t0, _, t1, _)) = box_span(r, *min, *max) {
                 span(t0, enter, t1, exit);
             }
         }
-        Solid::HalfSpace { normal, offset } => {
+        Some(Shape::Plane { normal, offset }) => {
             let nd = normal.dot(r.direction);
             let behind_origin = normal.dot(r.origin) <= *offset;
             if nd == 0.0 {
@@ -396,7 +366,7 @@ fn leaf_bounds(
                 }
             }
         }
-        Solid::Mesh(mesh) => {
+        Some(Shape::Mesh(mesh)) => {
             hits.clear();
             mesh.accel
                 .intersect_all(r, f32::NEG_INFINITY, f32::INFINITY, hits);
@@ -422,20 +392,21 @@ fn leaf_bounds(
                 span(pair[0], enter, pair[1], exit);
             }
         }
-        Solid::Empty => {}
+        Some(Shape::Csg(never)) => match *never {},
+        Some(Shape::Triangle { .. }) | None => {}
     }
 }
 
 /// The object-space outward normal of a leaf at the boundary the ray crosses at t.
-fn leaf_normal(solid: &Solid, r: &Ray, t: f32, exit: bool) -> Vec3 {
+fn leaf_normal(solid: &Option<LeafShape>, r: &Ray, t: f32, exit: bool) -> Vec3 {
     match solid {
-        Solid::Sphere { center, .. } => sphere_normal(*center, r.at(t)),
-        Solid::Box { min, max } => match box_span(r, *min, *max) {
+        Some(Shape::Sphere { center, .. }) => sphere_normal(*center, r.at(t)),
+        Some(Shape::Box { min, max }) => match box_span(r, *min, *max) {
             Some((_, f_in, _, f_out)) => box_face_normal(if exit { f_out } else { f_in }),
             None => Vec3::Z,
         },
-        Solid::HalfSpace { normal, .. } => *normal,
-        Solid::Mesh(mesh) => {
+        Some(Shape::Plane { normal, .. }) => *normal,
+        Some(Shape::Mesh(mesh)) => {
             let mut hits = Vec::new();
             mesh.accel
                 .intersect_all(r, t.next_down(), t.next_up(), &mut hits);
@@ -450,7 +421,8 @@ fn leaf_normal(solid: &Solid, r: &Ray, t: f32, exit: bool) -> Vec3 {
                 n
             }
         }
-        Solid::Empty => Vec3::Z,
+        Some(Shape::Csg(never)) => match *never {},
+        Some(Shape::Triangle { .. }) | None => Vec3::Z,
     }
 }
 

@@ -22,6 +22,7 @@ mod rules;
 pub mod sampling;
 mod shade;
 mod shade_lanes;
+mod shape;
 mod similitude;
 pub mod texture;
 mod whitted;

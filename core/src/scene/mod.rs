@@ -3,6 +3,7 @@
 //! compiles a snapshot of it.
 
 mod comments;
+mod field;
 mod graph;
 mod mesh;
 mod phong;
@@ -13,6 +14,7 @@ pub mod walk;
 pub mod words;
 
 pub use comments::{Anchor, Comments, SceneComments};
+pub use field::Field;
 pub use graph::{CsgOp, Graph, Node, NodeId, NodeKind};
 pub use mesh::{Mesh, MeshSlot, NotClosed, check_closed};
 pub use phong::{PHONG_FIELDS, Phong, PhongField, phong_field};

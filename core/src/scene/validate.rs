@@ -4,6 +4,7 @@
 
 use glam::{DMat3, DMat4, Vec3};
 
+use super::field::Field;
 use super::transform::{compose_f64, op_matrix_f64, unit};
 use super::walk::Walk;
 use super::words::{is_numberlike, is_word};
@@ -15,8 +16,8 @@ use super::{
 /// One broken rule of one item (a camera, a light, a node's own parameters, …).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Invalid {
-    /// The field at fault, as the file names it (`radius`, `direction`, `Scale`, …).
-    pub field: String,
+    /// The field at fault (its file name: `field.name()`).
+    pub field: Field,
     /// For a Transform: the position of the op at fault.
     pub op: Option<usize>,
     pub message: String,
@@ -26,9 +27,9 @@ pub struct Invalid {
 }
 
 impl Invalid {
-    fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
+    fn new(field: Field, message: impl Into<String>) -> Self {
         Invalid {
-            field: field.into(),
+            field,
             op: None,
             message: message.into(),
             incomplete: false,
@@ -59,7 +60,7 @@ pub enum Place {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Problem {
     pub place: Place,
-    pub field: String,
+    pub field: Field,
     pub op: Option<usize>,
     /// Names the place: `Sphere (node #4): radius must be positive, found -1`.
     pub message: String,
@@ -88,21 +89,19 @@ impl std::fmt::Display for Problem {
 /// singular.
 const MAX_CONDITION: f64 = 1e6;
 
-fn finite(name: &str, values: &[f32]) -> Result<(), Invalid> {
+fn finite(field: Field, values: &[f32]) -> Result<(), Invalid> {
     // No value in the message: a number field turns a typed "nan" into +inf, and showing
     // "inf" to someone who typed "nan" would only puzzle them.
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err(Invalid::new(
-            name,
-            format!("{name} must be a finite number"),
-        ))
+        let m = format!("{field} must be a finite number");
+        Err(Invalid::new(field, m))
     }
 }
 
-fn finite3(name: &str, v: Vec3) -> Result<(), Invalid> {
-    finite(name, &v.to_array())
+fn finite3(field: Field, v: Vec3) -> Result<(), Invalid> {
+    finite(field, &v.to_array())
 }
 
 pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
@@ -120,12 +119,12 @@ pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
             ..
         } => ("PerspectiveCamera", center, direction, up),
     };
-    finite3("center", *center)?;
-    finite3("direction", *direction)?;
-    finite3("up", *up)?;
+    finite3(Field::Center, *center)?;
+    finite3(Field::Direction, *direction)?;
+    finite3(Field::Up, *up)?;
     let Some(d) = unit(*direction) else {
         return Err(Invalid::new(
-            "direction",
+            Field::Direction,
             format!("{kw}: direction must not be zero"),
         ));
     };
@@ -134,26 +133,26 @@ pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
         Some(u) if u.cross(d).length_squared() > 1e-12 => {}
         _ => {
             return Err(Invalid::new(
-                "up",
+                Field::Up,
                 format!("{kw}: up must not be zero or parallel to direction"),
             ));
         }
     }
     match *c {
         Camera::Perspective { angle, .. } => {
-            finite("angle", &[angle])?;
+            finite(Field::Angle, &[angle])?;
             if !(angle > 0.0 && angle < 180.0) {
                 let m = format!(
                     "PerspectiveCamera: angle must be between 0 and 180 degrees, found {angle}"
                 );
-                return Err(Invalid::new("angle", m));
+                return Err(Invalid::new(Field::Angle, m));
             }
         }
         Camera::Orthographic { size, .. } => {
-            finite("size", &[size])?;
+            finite(Field::Size, &[size])?;
             if size <= 0.0 {
                 return Err(Invalid::new(
-                    "size",
+                    Field::Size,
                     format!("OrthographicCamera: size must be positive, found {size}"),
                 ));
             }
@@ -165,11 +164,11 @@ pub fn check_camera(c: &Camera) -> Result<(), Invalid> {
 pub fn check_light(l: &Light) -> Result<(), Invalid> {
     match l.kind {
         LightKind::Directional { direction } => {
-            finite3("direction", direction)?;
-            finite3("color", l.color)?;
+            finite3(Field::Direction, direction)?;
+            finite3(Field::Color, l.color)?;
             if unit(direction).is_none() {
                 return Err(Invalid::new(
-                    "direction",
+                    Field::Direction,
                     "DirectionalLight: direction must not be zero",
                 ));
             }
@@ -178,14 +177,14 @@ pub fn check_light(l: &Light) -> Result<(), Invalid> {
             position,
             attenuation,
         } => {
-            finite3("position", position)?;
-            finite3("color", l.color)?;
+            finite3(Field::Position, position)?;
+            finite3(Field::Color, l.color)?;
             if let Some(a) = attenuation {
-                finite3("attenuation", a)?;
+                finite3(Field::Attenuation, a)?;
                 // c + l·d + q·d² must stay positive for every distance d > 0.
                 if a.min_element() < 0.0 || a == Vec3::ZERO {
                     return Err(Invalid::new(
-                        "attenuation",
+                        Field::Attenuation,
                         format!(
                             "PointLight: attenuation (constant, linear, quadratic) must be \
                              non-negative and not all zero, found {} {} {}",
@@ -201,10 +200,10 @@ pub fn check_light(l: &Light) -> Result<(), Invalid> {
 
 pub fn check_background(b: &Background) -> Result<(), Invalid> {
     if let Some(c) = b.color {
-        finite3("color", c)?;
+        finite3(Field::Color, c)?;
     }
     if let Some(a) = b.ambient {
-        finite3("ambientLight", a)?;
+        finite3(Field::AmbientLight, a)?;
     }
     Ok(())
 }
@@ -214,16 +213,19 @@ pub fn check_background(b: &Background) -> Result<(), Invalid> {
 pub fn check_material(m: &Material) -> Result<(), Invalid> {
     if let Some(t) = &m.texture {
         if m.diffuse != Vec3::ZERO || !m.extra.is_empty() {
-            let name = m.extra.first().map_or("diffuseColor", |(n, _)| n.as_str());
+            let field = m
+                .extra
+                .first()
+                .map_or(Field::DiffuseColor, |(n, _)| Field::Material(n.clone()));
             let msg = format!(
-                "a {} takes its colours from its two materials; it has no {name} of its own",
+                "a {} takes its colours from its two materials; it has no {field} of its own",
                 t.kind.name()
             );
-            return Err(Invalid::new(name, msg));
+            return Err(Invalid::new(field, msg));
         }
         return check_texture(t);
     }
-    finite3("diffuseColor", m.diffuse)?;
+    finite3(Field::DiffuseColor, m.diffuse)?;
     for (i, (name, values)) in m.extra.iter().enumerate() {
         // The reader takes a number-like word as a value and `obj_file` as a mesh field.
         if !is_word(name) || is_numberlike(name) || name == "obj_file" {
@@ -231,15 +233,15 @@ pub fn check_material(m: &Material) -> Result<(), Invalid> {
                 "material field name \"{}\" cannot be written",
                 name.escape_debug()
             );
-            return Err(Invalid::new(name.clone(), m));
+            return Err(Invalid::new(Field::Material(name.clone()), m));
         }
         if name == "diffuseColor" || m.extra[..i].iter().any(|(n, _)| n == name) {
             return Err(Invalid::new(
-                name.clone(),
+                Field::Material(name.clone()),
                 format!("\"{name}\" is given twice in the material"),
             ));
         }
-        finite(name, values)?;
+        finite(Field::Material(name.clone()), values)?;
         check_phong_field(name, values)?;
     }
     Ok(())
@@ -255,23 +257,30 @@ pub fn check_texture(t: &SolidTexture) -> Result<(), Invalid> {
         }
         if let Some(why) = singular(DMat3::from_mat4(compose_f64(ops))) {
             return Err(Invalid::new(
-                "Transform",
+                Field::TextureTransform,
                 format!("singular transform: the combined operations {why}"),
             ));
         }
     }
     if !t.kind.has_octaves() && t.octaves != 0 {
-        return Err(Invalid::new("octaves", format!("a {kind} has no octaves")));
+        return Err(Invalid::new(
+            Field::Octaves,
+            format!("a {kind} has no octaves"),
+        ));
     }
     if t.octaves > MAX_OCTAVES {
         let m = format!("octaves must be 0 to {MAX_OCTAVES}, found {}", t.octaves);
-        return Err(Invalid::new("octaves", m));
+        return Err(Invalid::new(Field::Octaves, m));
     }
-    for (name, v) in [("frequency", t.frequency), ("amplitude", t.amplitude)] {
+    for (field, v) in [
+        (Field::Frequency, t.frequency),
+        (Field::Amplitude, t.amplitude),
+    ] {
         if !t.kind.has_waves() && v != 0.0 {
-            return Err(Invalid::new(name, format!("a {kind} has no {name}")));
+            let m = format!("a {kind} has no {field}");
+            return Err(Invalid::new(field, m));
         }
-        finite(name, &[v])?;
+        finite(field, &[v])?;
     }
     Ok(())
 }
@@ -386,15 +395,15 @@ fn check_phong_field(name: &str, values: &[f32]) -> Result<(), Invalid> {
             f.numbers,
             values.len()
         );
-        return Err(Invalid::new(name, m));
+        return Err(Invalid::new(Field::Material(name.into()), m));
     }
     match (name, values) {
         ("exponent", &[e]) if e < 0.0 => Err(Invalid::new(
-            name,
+            Field::Material(name.into()),
             format!("exponent must not be negative, found {e}"),
         )),
         ("indexOfRefraction", &[n]) if n <= 0.0 => Err(Invalid::new(
-            name,
+            Field::Material(name.into()),
             format!("indexOfRefraction must be positive, found {n}"),
         )),
         _ => Ok(()),
@@ -439,34 +448,35 @@ fn singular(a: DMat3) -> Option<&'static str> {
 /// and not singular by itself.
 pub fn check_op(op: &TransformOp) -> Result<(), Invalid> {
     let name = op.name();
+    let field = Field::Op(name);
     match op {
-        TransformOp::Scale(v) | TransformOp::Translate(v) => finite3(name, *v)?,
+        TransformOp::Scale(v) | TransformOp::Translate(v) => finite3(field.clone(), *v)?,
         TransformOp::UniformScale(s)
         | TransformOp::XRotate(s)
         | TransformOp::YRotate(s)
-        | TransformOp::ZRotate(s) => finite(name, &[*s])?,
+        | TransformOp::ZRotate(s) => finite(field.clone(), &[*s])?,
         TransformOp::Rotate { axis, degrees } => {
-            finite(name, &axis.to_array())?;
-            finite(name, &[*degrees])?;
+            finite(field.clone(), &axis.to_array())?;
+            finite(field.clone(), &[*degrees])?;
             if unit(*axis).is_none() {
-                return Err(Invalid::new(name, "Rotate: the axis must not be zero"));
+                return Err(Invalid::new(field, "Rotate: the axis must not be zero"));
             }
         }
         TransformOp::Matrix(m) => {
-            finite(name, &m.to_cols_array())?;
+            finite(field.clone(), &m.to_cols_array())?;
             let r = m.row(3);
             if r != glam::Vec4::W {
                 let m = format!(
                     "Matrix: the last row must be 0 0 0 1 (a projective matrix cannot move rays), found {} {} {} {}",
                     r.x, r.y, r.z, r.w
                 );
-                return Err(Invalid::new(name, m));
+                return Err(Invalid::new(field, m));
             }
         }
     }
     if let Some(why) = singular(DMat3::from_mat4(op_matrix_f64(op))) {
         return Err(Invalid::new(
-            name,
+            field,
             format!("singular transform: {} {why}", op.summary()),
         ));
     }
@@ -505,38 +515,41 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
             }
             if let Some(why) = singular(DMat3::from_mat4(compose_f64(ops))) {
                 return Err(Invalid::new(
-                    "ops",
+                    Field::Ops,
                     format!("singular transform: the combined operations {why}"),
                 ));
             }
         }
         NodeKind::Sphere { center, radius } => {
-            finite3("center", *center)?;
-            finite("radius", &[*radius])?;
+            finite3(Field::Center, *center)?;
+            finite(Field::Radius, &[*radius])?;
             if *radius <= 0.0 {
                 return Err(Invalid::new(
-                    "radius",
+                    Field::Radius,
                     format!("Sphere: radius must be positive, found {radius}"),
                 ));
             }
         }
         NodeKind::Plane { normal, offset } => {
-            finite3("normal", *normal)?;
-            finite("offset", &[*offset])?;
+            finite3(Field::Normal, *normal)?;
+            finite(Field::Offset, &[*offset])?;
             if unit(*normal).is_none() {
-                return Err(Invalid::new("normal", "Plane: normal must not be zero"));
+                return Err(Invalid::new(
+                    Field::Normal,
+                    "Plane: normal must not be zero",
+                ));
             }
         }
         NodeKind::Triangle { vertices } => {
-            for (name, v) in ["vertex0", "vertex1", "vertex2"].into_iter().zip(vertices) {
-                finite3(name, *v)?;
+            for (i, v) in vertices.iter().enumerate() {
+                finite3(Field::Vertex(i), *v)?;
             }
         }
         NodeKind::TriangleMesh { obj_file, .. } => {
             if obj_file.is_empty() {
                 return Err(Invalid {
                     incomplete: true,
-                    ..Invalid::new("obj_file", "TriangleMesh: no OBJ file chosen yet")
+                    ..Invalid::new(Field::ObjFile, "TriangleMesh: no OBJ file chosen yet")
                 });
             }
             if !is_word(obj_file) {
@@ -544,15 +557,15 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
                     "TriangleMesh: \"{}\" cannot be written as a file name (no spaces, braces or #)",
                     obj_file.escape_debug()
                 );
-                return Err(Invalid::new("obj_file", m));
+                return Err(Invalid::new(Field::ObjFile, m));
             }
         }
         NodeKind::Box { min, max } => {
-            finite3("min", *min)?;
-            finite3("max", *max)?;
+            finite3(Field::Min, *min)?;
+            finite3(Field::Max, *max)?;
             if min.cmpgt(*max).any() {
                 return Err(Invalid::new(
-                    "max",
+                    Field::Max,
                     "Box: min must not exceed max on any axis",
                 ));
             }
@@ -560,7 +573,7 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
             // and as a CSG operand it is empty. Refused, to say so.
             if let Some(axis) = (0..3).find(|&k| min[k] == max[k]) {
                 return Err(Invalid::new(
-                    "max",
+                    Field::Max,
                     format!(
                         "Box: min and max are equal on {} ({}), so the box is flat and would not be seen; give it a thickness",
                         ["x", "y", "z"][axis],
@@ -575,32 +588,87 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
 
 /// Whether `id` bounds a solid (a CSG operand): Transforms are followed to what they move.
 pub fn is_solid(graph: &Graph, id: NodeId) -> bool {
+    not_a_solid(graph, id).is_none() && !ends_in_empty_transform(graph, id)
+}
+
+/// The object at the end of `id`'s Transforms, when it is not a solid: a Triangle or a
+/// Group. A Transform holding nothing is judged by its own rule, not here.
+fn not_a_solid(graph: &Graph, id: NodeId) -> Option<NodeId> {
     let mut cur = id;
     loop {
-        match graph.get(cur).map(|n| (&n.kind, n.children.first())) {
-            Some((NodeKind::Transform(_), Some(&c))) => cur = c,
-            Some((
-                NodeKind::Sphere { .. }
-                | NodeKind::Box { .. }
-                | NodeKind::Plane { .. }
-                | NodeKind::Csg(_)
-                | NodeKind::TriangleMesh { .. },
-                _,
-            )) => return true,
-            _ => return false,
+        let node = graph.get(cur)?;
+        match &node.kind {
+            NodeKind::Transform(_) => cur = *node.children.first()?,
+            NodeKind::Triangle { .. } | NodeKind::Group => return Some(cur),
+            _ => return None,
         }
     }
 }
 
+fn ends_in_empty_transform(graph: &Graph, id: NodeId) -> bool {
+    let mut cur = id;
+    while let Some(n) = graph.get(cur) {
+        match (&n.kind, n.children.first()) {
+            (NodeKind::Transform(_), Some(&c)) => cur = c,
+            (NodeKind::Transform(_), None) => return true,
+            _ => return false,
+        }
+    }
+    true
+}
+
+/// A MaterialIndex (as written: a file may give one past `u32`) against the scene's
+/// materials.
+pub fn check_material_index(index: u64, n_materials: usize) -> Result<(), Invalid> {
+    if index < n_materials as u64 {
+        return Ok(());
+    }
+    let range = if n_materials == 0 {
+        "the scene has no materials".to_string()
+    } else {
+        format!("valid indices are 0 to {}", n_materials - 1)
+    };
+    Err(Invalid::new(
+        Field::MaterialIndex,
+        format!("MaterialIndex {index} is out of range: {range}"),
+    ))
+}
+
 /// Rules about the object graph: each node's parameters, Transform and CSG child counts,
 /// CSG operands that are solids, materials in range and placed where the file can say
-/// them, and every Transform's world-from-object matrix composed through its whole chain.
+/// them, and every Transform's world-from-object matrix composed through its whole chain
+/// (not below a node whose own parameters are already at fault).
 pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
     let mut out = Vec::new();
+    // Nodes whose own parameters break a rule: their chain says the same thing again.
+    let mut own = std::collections::HashSet::new();
+    // Every Transform's world-from-object matrix, composed in f64 through its whole chain
+    // of ancestors, in the same walk; only the outermost failing Transform of a chain is
+    // reported (`below`: its depth, while the walk is inside it).
+    let mut chain = Vec::new();
+    let mut below: Option<usize> = None;
     for v in Walk::new(graph) {
         let (id, node, parent) = (v.id, v.node, v.parent);
+        if below.is_some_and(|d| v.depth > d) {
+            // Inside a chain already reported.
+        } else if let NodeKind::Transform(_) = &node.kind
+            && let Err(e) = check_world_from_object(&v.world_from_object)
+        {
+            let message = e.to_string();
+            chain.push(Problem {
+                place: Place::Node(id),
+                field: Field::Ops,
+                op: None,
+                reason: message.clone(),
+                message,
+                incomplete: false,
+            });
+            below = Some(v.depth);
+        } else {
+            below = None;
+        }
         let name = node.kind.name();
-        let mut push = |field: &str, op: Option<usize>, reason: String, incomplete: bool| {
+        let mut push = |field: Field, op: Option<usize>, reason: String, incomplete: bool| {
             // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
             let rest = reason
                 .strip_prefix(name)
@@ -608,7 +676,7 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
                 .unwrap_or(&reason);
             out.push(Problem {
                 place: Place::Node(id),
-                field: field.to_string(),
+                field,
                 op,
                 message: format!("{name} (node #{}): {rest}", id.0),
                 reason: reason.clone(),
@@ -616,7 +684,8 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
             })
         };
         if let Err(e) = check_kind(&node.kind) {
-            push(&e.field, e.op, e.message, e.incomplete);
+            own.insert(Place::Node(id));
+            push(e.field, e.op, e.message, e.incomplete);
         }
         if let Some(m) = node.material {
             let parent_kind = parent.and_then(|p| graph.get(p)).map(|p| &p.kind);
@@ -624,80 +693,67 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
                 let m = format!(
                     "MaterialIndex {m} can only be set on an object listed in a Group or CSG node"
                 );
-                push("material", None, m, false);
+                push(Field::MaterialIndex, None, m, false);
             }
-            if m as usize >= n_materials {
-                let m = format!(
-                    "MaterialIndex {m} is out of range: the scene has {n_materials} material(s)"
-                );
-                push("material", None, m, false);
+            if let Err(e) = check_material_index(u64::from(m), n_materials) {
+                push(e.field, None, e.message, false);
             }
         }
         match &node.kind {
-            NodeKind::Transform(_) if node.children.len() != 1 => {
-                push(
-                    "children",
-                    None,
-                    "a Transform holds exactly one object".into(),
-                    false,
-                );
+            NodeKind::Transform(_) if node.children.is_empty() => {
+                let m = "Transform needs one object after its operations".to_string();
+                push(Field::Children, None, m, false);
+            }
+            NodeKind::Transform(_) => {
+                for &c in &node.children[1..] {
+                    let m = "a Transform holds exactly one object; this is a second (wrap them \
+                             in a Group)";
+                    push(Field::Child(c), None, m.into(), false);
+                }
             }
             NodeKind::Csg(op) => {
-                if node.children.len() != 2 {
-                    push(
-                        "children",
-                        None,
-                        format!("{} needs exactly two operand objects", op.name()),
-                        false,
+                let op = op.name();
+                let n = node.children.len();
+                if n != 2 {
+                    let m = format!(
+                        "{op} needs exactly two operand objects (nest them for more), found {n}"
                     );
+                    push(Field::Children, None, m, false);
                 }
                 for &c in &node.children {
-                    if !is_solid(graph, c) {
-                        let what = graph.get(c).map_or("?", |n| n.kind.name());
-                        let m = format!(
-                            "a {what} is not a solid, so it cannot be an operand of {}",
-                            op.name()
-                        );
-                        push("children", None, m, false);
-                    }
+                    let Some(at) = not_a_solid(graph, c) else {
+                        continue;
+                    };
+                    let m = match graph.get(at).map(|n| &n.kind) {
+                        Some(NodeKind::Group) => format!(
+                            "a Group cannot be an operand of {op}: operands are solids (Sphere, \
+                             Box, Plane, closed TriangleMesh, a Transform of one, or Union, \
+                             Intersection, Subtraction); combine several with Union"
+                        ),
+                        _ => format!(
+                            "a lone Triangle is not a solid, so it cannot be an operand of {op} \
+                             (use a closed TriangleMesh)"
+                        ),
+                    };
+                    push(Field::Child(at), None, m, false);
                 }
             }
             _ => {}
         }
     }
-    out.extend(check_world_chain(graph).into_iter().map(|p| Problem {
-        message: format!(
-            "Transform (node #{}): {}",
-            p.node().map_or(0, |n| n.0),
-            p.message
-        ),
-        ..p
-    }));
-    out
-}
-
-/// Every Transform's world-from-object matrix, composed in f64 through its whole chain of
-/// ancestors. Only the outermost failing Transform of a chain is reported; messages do not
-/// name the node (the parser gives its location instead).
-pub fn check_world_chain(graph: &Graph) -> Vec<Problem> {
-    let mut out = Vec::new();
-    let mut walk = Walk::new(graph);
-    while let Some(v) = walk.next() {
-        if let NodeKind::Transform(_) = &v.node.kind
-            && let Err(e) = check_world_from_object(&v.world_from_object)
-        {
-            let message = e.to_string();
-            out.push(Problem {
-                place: Place::Node(v.id),
-                field: "ops".into(),
-                op: None,
-                reason: message.clone(),
-                message,
-                incomplete: false,
-            });
-            walk.skip_children();
-        }
-    }
+    out.extend(
+        chain
+            .into_iter()
+            .filter(|p| !own.contains(&p.place))
+            .map(|p| Problem {
+                message: format!(
+                    "Transform (node #{}): {}",
+                    p.node().map_or(0, |n| n.0),
+                    p.message
+                ),
+                ..p
+            }),
+    );
     out
 }
 
@@ -736,7 +792,7 @@ pub fn check_scene(scene: &Scene) -> Vec<Problem> {
     for (i, slot, reason) in check_texture_refs(&scene.materials) {
         out.push(Problem {
             place: Place::Material(i),
-            field: format!("materialIndex {}", slot + 1),
+            field: Field::TextureMaterial(slot),
             op: None,
             message: format!("material {i}: {reason}"),
             reason,
@@ -779,7 +835,7 @@ mod tests {
             TransformOp::Scale(Vec3::new(1.0, 0.0, 1.0)),
         ])
         .expect_err("flat");
-        assert_eq!((e.field.as_str(), e.op), ("Scale", Some(1)));
+        assert_eq!((e.field, e.op), (Field::Op("Scale"), Some(1)));
     }
 
     #[test]
@@ -810,19 +866,19 @@ mod tests {
             check_camera(&cam(Vec3::Y * 2.0, Vec3::Y, 1.0))
                 .expect_err("parallel")
                 .field,
-            "up"
+            Field::Up
         );
         assert_eq!(
             check_camera(&cam(Vec3::NEG_Z, Vec3::Y, 0.0))
                 .expect_err("size 0")
                 .field,
-            "size"
+            Field::Size
         );
         assert_eq!(
             check_camera(&cam(Vec3::NEG_Z, Vec3::Y, f32::NAN))
                 .expect_err("nan")
                 .field,
-            "size"
+            Field::Size
         );
     }
 
@@ -868,6 +924,52 @@ mod tests {
         ] {
             assert!(check_material(&with(bad)).is_err(), "{bad:?}");
         }
+    }
+
+    #[test]
+    fn graph_verdicts_name_the_child_at_fault_by_field() {
+        let sphere = || {
+            Node::new(NodeKind::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            })
+        };
+        // A Transform of two objects: the second is named, where the parser places it.
+        let mut g = Graph::new();
+        let t = g.add(Node::new(NodeKind::Transform(Vec::new())));
+        let (a, b) = (g.add(sphere()), g.add(sphere()));
+        g.push_child(g.root(), t);
+        g.push_child(t, a);
+        g.push_child(t, b);
+        let p = check_graph(&g, 0);
+        assert_eq!(p.len(), 1, "{p:?}");
+        assert_eq!(
+            (p[0].place, &p[0].field),
+            (Place::Node(t), &Field::Child(b))
+        );
+        // A CSG operand through a Transform: the Triangle it leads to is named.
+        let mut g = Graph::new();
+        let u = g.add(Node::new(NodeKind::Csg(super::super::CsgOp::Union)));
+        let t = g.add(Node::new(NodeKind::Transform(Vec::new())));
+        let tri = g.add(Node::new(NodeKind::Triangle {
+            vertices: [Vec3::ZERO, Vec3::X, Vec3::Y],
+        }));
+        let s = g.add(sphere());
+        g.push_child(g.root(), u);
+        g.push_child(u, t);
+        g.push_child(t, tri);
+        g.push_child(u, s);
+        let p = check_graph(&g, 0);
+        assert_eq!(p.len(), 1, "{p:?}");
+        assert_eq!(
+            (p[0].place, &p[0].field),
+            (Place::Node(u), &Field::Child(tri))
+        );
+        assert!(
+            p[0].reason.starts_with("a lone Triangle is not a solid"),
+            "{p:?}"
+        );
+        assert!(!is_solid(&g, t) && is_solid(&g, s));
     }
 
     #[test]

@@ -72,38 +72,38 @@ pub enum Pending {
 const MAX_RECENT: usize = 10;
 
 pub struct TracelabApp {
-    pub doc: Document,
-    pub worker: RenderWorker,
-    pub view: ViewSettings,
+    doc: Document,
+    worker: RenderWorker,
+    view: ViewSettings,
     viewport: Viewport,
     /// The last pixel inspected and the scene snapshot it was traced in.
-    pub story: Option<(RayStory, Arc<Scene>)>,
+    story: Option<(RayStory, Arc<Scene>)>,
     /// Which pixel that is and the render it was traced in: every new render traces it again.
-    pub inspected: Option<Inspected>,
-    pub pixel_inspector_open: bool,
+    inspected: Option<Inspected>,
+    pixel_inspector_open: bool,
     /// The Ray panel (world and object space diagrams) in the dock, beside the story.
-    pub ray_panel_open: bool,
+    ray_panel_open: bool,
     /// The Ray panel's diagrams in their own window instead of the dock.
-    pub ray_window: bool,
+    ray_window: bool,
     /// File › Export animation's form, while open, and the export under way.
-    pub animation: Option<AnimationForm>,
-    pub animation_running: Option<animation_dialog::Running>,
+    animation: Option<AnimationForm>,
+    animation_running: Option<animation_dialog::Running>,
     /// The Lecture menu's figure on show, for its caption.
-    pub lecture: Option<usize>,
+    lecture: Option<usize>,
     /// A figure whose scene is being read (or waits for the unsaved-changes answer): its view
     /// and caption are applied when that scene is installed, and dropped if it is not.
     pending_lecture: Option<usize>,
     /// View › Uniform grid: the course's grid instead of the BVH, or its picture.
-    pub grid: GridSettings,
+    grid: GridSettings,
     /// The grid and the inspected pixel's walk through it, while the render on screen went
     /// through a grid (drawn in the Ray panel's world diagram).
-    pub grid_pick: Option<GridPick>,
+    grid_pick: Option<GridPick>,
     /// How each Ray diagram (world, object) is turned.
-    pub ray_orbits: [Orbit; 2],
-    pub dialog: Option<FileDialog>,
+    ray_orbits: [Orbit; 2],
+    dialog: Option<FileDialog>,
     native: Option<NativeDialog>,
     native_dialogs: bool,
-    pub confirm: Option<Pending>,
+    confirm: Option<Pending>,
     /// A file read while there were unsaved changes, waiting for the answer to `confirm`.
     ready: Option<SceneRead>,
     /// The file being read in the background, if any.
@@ -119,25 +119,135 @@ pub struct TracelabApp {
     widget_epoch: u64,
     /// The document generation right after the panels' edits were applied.
     panels_generation: u64,
-    pub recent: Vec<PathBuf>,
+    recent: Vec<PathBuf>,
     rows: (u64, Vec<TreeRow>, (usize, usize, usize)),
     file_watch: FileWatch,
     /// The file changed on disk while there were unsaved edits: ask before reloading.
-    pub disk_changed: bool,
+    disk_changed: bool,
     title: String,
     allow_close: bool,
     /// The selection the tree last showed, to scroll to selections made elsewhere.
     tree_seen: Option<Selection>,
     /// Timings in the status bar; snapshot tests turn them off to stay deterministic.
-    pub show_timings: bool,
+    show_timings: bool,
     /// What the UI asked for this frame, carried out by [`Self::run_commands`].
     commands: Vec<AppCommand>,
     /// A note for the status bar (what a gizmo drag added), and when it was made.
-    pub note: Option<(String, Instant)>,
+    note: Option<(String, Instant)>,
     /// The size the view renders at, for framing.
     render_size: (u32, u32),
     /// When the last frame's UI code ended (the edit → screen timing log).
     last_frame_end: Option<Instant>,
+}
+
+/// What other modules and the tests read and set; the fields are the app's own.
+impl TracelabApp {
+    pub fn doc(&self) -> &Document {
+        &self.doc
+    }
+
+    /// The document itself (tests select or edit directly; the panels go through commands).
+    pub fn doc_mut(&mut self) -> &mut Document {
+        &mut self.doc
+    }
+
+    pub fn worker(&self) -> &RenderWorker {
+        &self.worker
+    }
+
+    /// The render worker (a test swaps in one that failed to start).
+    pub fn worker_mut(&mut self) -> &mut RenderWorker {
+        &mut self.worker
+    }
+
+    pub fn view(&self) -> &ViewSettings {
+        &self.view
+    }
+
+    pub fn view_mut(&mut self) -> &mut ViewSettings {
+        &mut self.view
+    }
+
+    /// The last pixel inspected and the scene snapshot it was traced in.
+    pub fn story(&self) -> Option<&(RayStory, Arc<Scene>)> {
+        self.story.as_ref()
+    }
+
+    /// View › Uniform grid's setting.
+    pub fn grid(&self) -> &GridSettings {
+        &self.grid
+    }
+
+    /// The picked pixel's walk through the grid, when the view renders through one.
+    pub fn grid_pick(&self) -> Option<&GridPick> {
+        self.grid_pick.as_ref()
+    }
+
+    /// The pixel the pixel inspector describes.
+    pub fn inspected(&self) -> Option<&Inspected> {
+        self.inspected.as_ref()
+    }
+
+    /// Whether the Ray panel's diagrams are in their own window instead of the dock.
+    pub fn ray_window(&self) -> bool {
+        self.ray_window
+    }
+
+    /// Whether the file changed on disk while there are unsaved edits (the question is up).
+    pub fn disk_changed(&self) -> bool {
+        self.disk_changed
+    }
+
+    pub fn pixel_inspector_open(&self) -> bool {
+        self.pixel_inspector_open
+    }
+
+    /// File › Export animation's form, while open.
+    pub fn animation(&self) -> Option<&AnimationForm> {
+        self.animation.as_ref()
+    }
+
+    pub fn set_animation(&mut self, form: Option<AnimationForm>) {
+        self.animation = form;
+    }
+
+    /// Whether an animation export is under way.
+    pub fn animation_running(&self) -> bool {
+        self.animation_running.is_some()
+    }
+
+    /// The Lecture menu's figure on show.
+    pub fn lecture(&self) -> Option<usize> {
+        self.lecture
+    }
+
+    pub fn dialog(&self) -> Option<&FileDialog> {
+        self.dialog.as_ref()
+    }
+
+    pub fn set_dialog(&mut self, dialog: Option<FileDialog>) {
+        self.dialog = dialog;
+    }
+
+    /// The question waiting for an answer (unsaved changes, a lossy save).
+    pub fn confirm(&self) -> Option<&Pending> {
+        self.confirm.as_ref()
+    }
+
+    /// Recently opened files, newest first.
+    pub fn recent(&self) -> &[PathBuf] {
+        &self.recent
+    }
+
+    /// The status bar's note (what a gizmo drag added), while it shows.
+    pub fn note(&self) -> Option<&str> {
+        self.note.as_ref().map(|(text, _)| text.as_str())
+    }
+
+    /// Timings in the status bar (snapshot tests turn them off to stay deterministic).
+    pub fn set_show_timings(&mut self, on: bool) {
+        self.show_timings = on;
+    }
 }
 
 impl TracelabApp {

@@ -2,14 +2,15 @@
 //! and tests, and the refused edit's reason shown beside the field it names.
 
 use glam::Vec3;
-use tracelab_core::Place;
+use tracelab_core::{Field, Place};
 
 use crate::document::Document;
 use crate::document::edit::Refusal;
 use crate::gui::widgets::{number, render_from_swatch, swatch_from_render};
 
-/// Three drag values labelled for screen readers and tests (e.g. "Translate x").
-pub(super) fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> bool {
+/// Three drag values labelled for screen readers and tests (e.g. "Translate x"); a refusal
+/// about `field` shows under them.
+pub(super) fn vec3(ui: &mut egui::Ui, name: &str, field: Field, v: &mut Vec3, speed: f64) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
         ui.label(name);
@@ -21,7 +22,7 @@ pub(super) fn vec3(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f64) -> b
     });
     // Under the row, not beside it: the row's width is taken, and a wrapped reason one word
     // a line is hard to read.
-    refusal_note(ui, name);
+    refusal_note(ui, &field);
     changed
 }
 
@@ -33,7 +34,7 @@ pub(super) fn name_widget(r: &egui::Response, name: String, value: f64) {
     });
 }
 
-pub(super) fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> bool {
+pub(super) fn scalar(ui: &mut egui::Ui, name: &str, field: Field, v: &mut f32, speed: f64) -> bool {
     let changed = ui
         .horizontal(|ui| {
             ui.label(name);
@@ -42,7 +43,7 @@ pub(super) fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> 
             r.changed()
         })
         .inner;
-    refusal_note(ui, name);
+    refusal_note(ui, &field);
     changed
 }
 
@@ -51,7 +52,7 @@ pub(super) fn scalar(ui: &mut egui::Ui, name: &str, v: &mut f32, speed: f64) -> 
 /// names without a parameter each.
 #[derive(Clone)]
 struct Note {
-    field: String,
+    field: Field,
     op: Option<usize>,
     reason: String,
 }
@@ -70,10 +71,12 @@ pub(super) fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Plac
         .refusal
         .as_ref()
         .filter(|r: &&Refusal| r.place.is_some() && r.place == place)
-        .map(|r| Note {
-            field: r.field.clone(),
-            op: r.op,
-            reason: r.reason.clone(),
+        .and_then(|r| {
+            Some(Note {
+                field: r.field.clone()?,
+                op: r.op,
+                reason: r.reason.clone(),
+            })
         });
     ui.data_mut(|d| {
         d.insert_temp(note_id(), note);
@@ -81,29 +84,16 @@ pub(super) fn show_refusal_for(ui: &egui::Ui, doc: &Document, place: Option<Plac
     });
 }
 
-/// Whether the widget labelled `label` edits the file's field `field` ("angle (degrees)"
-/// edits "angle", "Rotate axis" edits "Rotate", "colour" edits "color").
-fn same_field(label: &str, field: &str) -> bool {
-    let label = label.split(" (").next().unwrap_or(label);
-    label == field
-        || label
-            .strip_prefix(field)
-            .is_some_and(|rest| rest.starts_with(' '))
-        || matches!(
-            (label, field),
-            ("colour", "color") | ("ambient light", "ambientLight")
-        )
-        || (label.ends_with(": diffuse") && field == "diffuseColor")
-}
-
-pub(super) fn refusal_note(ui: &mut egui::Ui, label: &str) {
+/// The refusal's reason under the widget that edits `field`, if the refusal names it (and,
+/// inside a Transform's op, that op).
+pub(super) fn refusal_note(ui: &mut egui::Ui, field: &Field) {
     let (note, op) = ui.data(|d| {
         (
             d.get_temp::<Option<Note>>(note_id()).flatten(),
             d.get_temp::<Option<usize>>(op_id()).flatten(),
         )
     });
-    if let Some(n) = note.filter(|n| n.op == op && same_field(label, &n.field)) {
+    if let Some(n) = note.filter(|n| n.op == op && n.field == *field) {
         // Wrapped to the panel: a long reason must not widen it.
         ui.add(
             egui::Label::new(egui::RichText::new(n.reason).color(ui.visuals().error_fg_color))
@@ -112,14 +102,14 @@ pub(super) fn refusal_note(ui: &mut egui::Ui, label: &str) {
     }
 }
 
-pub(super) fn color(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool {
+pub(super) fn color(ui: &mut egui::Ui, name: &str, field: Field, c: &mut Vec3) -> bool {
     let changed = ui
         .horizontal(|ui| {
             ui.label(name);
             color_values(ui, name, c)
         })
         .inner;
-    refusal_note(ui, name);
+    refusal_note(ui, &field);
     changed
 }
 
@@ -134,7 +124,8 @@ pub(super) fn color_values(ui: &mut egui::Ui, name: &str, c: &mut Vec3) -> bool 
         rgb = render_from_swatch(swatch);
     }
     for (v, channel) in rgb.iter_mut().zip(["r", "g", "b"]) {
-        let r = number(ui, v, |d| d.speed(0.005).range(0.0..=4.0).max_decimals(3));
+        // No range of its own: the file's rules (a finite number) are the only limit.
+        let r = number(ui, v, |d| d.speed(0.005).max_decimals(3));
         name_widget(&r, format!("{name} {channel}"), f64::from(*v));
         changed |= r.changed();
     }

@@ -5,8 +5,8 @@
 //! the diffuse colour.
 
 use glam::Vec3;
-use tracelab_core::Material;
 use tracelab_core::scene::{PHONG_FIELDS, Phong, PhongField, phong_field};
+use tracelab_core::{Field, Material};
 
 use super::fields::{color_values, name_widget, refusal_note};
 use crate::gui::widgets::number;
@@ -43,7 +43,7 @@ pub(super) fn fields(ui: &mut egui::Ui, m: &Material) -> Option<Material> {
                 changed = true;
             }
         });
-        refusal_note(ui, f.name);
+        refusal_note(ui, &Field::Material(f.name.to_string()));
         if changed {
             let mut next = edited.take().unwrap_or_else(|| m.clone());
             if present {

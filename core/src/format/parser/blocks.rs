@@ -186,7 +186,10 @@ impl Parser<'_> {
             comments,
         };
         if let Err(e) = validate::check_light(&light) {
-            self.error(self.field_offset(&f, &e.field).unwrap_or(off), e.message);
+            self.error(
+                self.field_offset(&f, &e.field.name()).unwrap_or(off),
+                e.message,
+            );
         }
         Some(light)
     }
@@ -272,7 +275,10 @@ impl Parser<'_> {
         };
         // Ranges (a negative exponent, an index of refraction ≤ 0), at the field at fault.
         if let Err(e) = validate::check_material(&m) {
-            self.error(self.field_offset(&f, &e.field).unwrap_or(off), e.message);
+            self.error(
+                self.field_offset(&f, &e.field.name()).unwrap_or(off),
+                e.message,
+            );
             return None;
         }
         Some(m)

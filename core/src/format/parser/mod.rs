@@ -15,15 +15,15 @@ mod objects;
 mod reader;
 mod texture;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use super::diagnostic::{Diagnostic, Diagnostics, Severity, SourceFile};
 use super::token_stream::TokenStream;
 
 use crate::scene::{
-    Background, Camera, CsgOp, Graph, Light, Material, NodeId, NodeKind, Scene, SceneComments,
-    validate,
+    Background, Camera, CsgOp, Field, Graph, Light, Material, NodeId, NodeKind, Place, Problem,
+    Scene, SceneComments, validate,
 };
 
 /// What one read of a scene file gave. `scene` is `Some` when the file's structure was read
@@ -167,9 +167,9 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
         material_refs: Vec::new(),
         texture_refs: Vec::new(),
         leaf_offsets: Vec::new(),
-        node_offsets: Vec::new(),
+        spans: Vec::new(),
+        lost_objects: HashSet::new(),
         mesh_name_offsets: Vec::new(),
-        mesh_operands: Vec::new(),
         last_obj_name: 0,
     };
     p.parse_file();
@@ -201,21 +201,30 @@ struct Parser<'a> {
     background: Option<Background>,
     materials: Vec<Material>,
     graph: Option<Graph>,
-    /// (index, offset) of each MaterialIndex, checked once all materials are known.
-    material_refs: Vec<(u32, usize)>,
+    /// (index as written, offset) of each MaterialIndex, checked once all materials are
+    /// known.
+    material_refs: Vec<(u64, usize)>,
     /// Where each texture's materialIndex lines stand, checked once all materials are known.
     texture_refs: Vec<TextureRefs>,
     /// (node, offset) of each primitive, for warnings that need the final tree.
     leaf_offsets: Vec<(NodeId, usize)>,
-    /// Offset of each object's keyword, indexed by node id (for errors about operands).
-    node_offsets: Vec<usize>,
+    /// Where each node stands, indexed by node id: the rules' verdicts on the graph are
+    /// placed with it.
+    spans: Vec<NodeSpan>,
+    /// Transform and CSG nodes that lost an object the file gives them (misspelt or
+    /// unreadable, reported where it stands): their count of objects is not reported too.
+    lost_objects: HashSet<NodeId>,
     /// (node, offset of its file name) of each TriangleMesh, for the resolve step.
     mesh_name_offsets: Vec<(NodeId, usize)>,
-    /// (mesh node, operation, offset) of each TriangleMesh that is a CSG operand: the
-    /// resolve step checks that it is closed.
-    mesh_operands: Vec<(NodeId, CsgOp, usize)>,
     /// Offset of the last TriangleMesh's file name, read by `start_object`.
     last_obj_name: usize,
+}
+
+/// Where a node stands in the file: its keyword, and the MaterialIndex that applies to it.
+#[derive(Clone, Copy, Debug, Default)]
+struct NodeSpan {
+    keyword: usize,
+    material: Option<usize>,
 }
 
 /// Where a texture's lines stand, for errors found once every material is read.
@@ -269,18 +278,13 @@ impl Parser<'_> {
         let end = self.src.text.len();
         self.scene_comments.end = self.comments_before(self.toks.len());
         let n = self.materials.len();
+        // Each line once, also one that applies to no object; the objects after it are
+        // not reported again (`judge_graph`).
+        let mut placed = HashSet::new();
         for (i, at) in std::mem::take(&mut self.material_refs) {
-            if i as usize >= n {
-                let range = if n == 0 {
-                    "the scene has no materials".to_string()
-                } else {
-                    format!("valid indices are 0 to {}", n - 1)
-                };
-                let written = self.word_at(at);
-                self.error(
-                    at,
-                    format!("MaterialIndex {written} is out of range: {range}"),
-                );
+            if let Err(e) = validate::check_material_index(i, n) {
+                self.error(at, e.message);
+                placed.insert((at, e.field));
             }
         }
         for (i, slot, reason) in validate::check_texture_refs(&self.materials) {
@@ -297,15 +301,9 @@ impl Parser<'_> {
         if self.graph.is_none() && !self.group_seen {
             self.error(end, "the scene has no Group of objects");
         }
-        if let Some(graph) = &self.graph {
-            // Composed through each chain, so nested scales are judged together.
-            for p in validate::check_world_chain(graph) {
-                let at = p
-                    .node()
-                    .and_then(|id| self.node_offsets.get(id.index()).copied())
-                    .unwrap_or(0);
-                self.error(at, p.message);
-            }
+        if let Some(graph) = self.graph.take() {
+            self.judge_graph(&graph, n, placed);
+            self.graph = Some(graph);
         }
         if let Some(graph) = &self.graph {
             let eff = graph.effective_materials();
@@ -352,6 +350,68 @@ impl Parser<'_> {
         }
     }
 
+    /// The graph rules of `validate`, once over the whole tree (chains of Transforms
+    /// composed, so nested scales are judged together), each verdict placed where its node,
+    /// child or MaterialIndex stands.
+    /// `placed`: what was reported already, by place and field (each MaterialIndex line).
+    fn judge_graph(
+        &mut self,
+        graph: &Graph,
+        n_materials: usize,
+        mut placed: HashSet<(usize, Field)>,
+    ) {
+        for p in validate::check_graph(graph, n_materials) {
+            let Some(at) = self.place_of(&p) else {
+                continue;
+            };
+            // One verdict per place and field: a MaterialIndex line once, not once per
+            // object after it.
+            if placed.insert((at, p.field.clone())) {
+                self.error(at, p.reason);
+            }
+        }
+    }
+
+    /// Where a verdict on the graph stands, or None when the file already says why (a
+    /// count of objects in a block that lost one).
+    fn place_of(&self, p: &Problem) -> Option<usize> {
+        let Place::Node(id) = p.place else {
+            return Some(0);
+        };
+        let span = |id: NodeId| self.spans.get(id.index()).copied().unwrap_or_default();
+        match &p.field {
+            Field::Children if self.lost_objects.contains(&id) => None,
+            Field::Child(c) => Some(span(*c).keyword),
+            Field::MaterialIndex => Some(span(id).material.unwrap_or(span(id).keyword)),
+            _ => Some(span(id).keyword),
+        }
+    }
+
+    /// Each TriangleMesh that is a CSG operand (through Transforms), with its operation
+    /// and where it stands: the resolve step checks that it is closed.
+    fn mesh_operands(&self, graph: &Graph) -> Vec<(NodeId, CsgOp, usize)> {
+        let mut out = Vec::new();
+        for (_, node) in graph.iter() {
+            let NodeKind::Csg(op) = node.kind else {
+                continue;
+            };
+            for &c in &node.children {
+                let mut cur = c;
+                while let Some(NodeKind::Transform(_)) = graph.get(cur).map(|n| &n.kind) {
+                    match graph.node(cur).children.first() {
+                        Some(&next) => cur = next,
+                        None => break,
+                    }
+                }
+                if let Some(NodeKind::TriangleMesh { .. }) = graph.get(cur).map(|n| &n.kind) {
+                    let at = self.spans.get(cur.index()).map_or(0, |s| s.keyword);
+                    out.push((cur, op, at));
+                }
+            }
+        }
+        out
+    }
+
     /// The TriangleMesh nodes with their file names and locations (also for a scene too
     /// broken to keep, so that a missing OBJ file is reported with the other errors).
     fn mesh_refs(&self, scene: Option<&Scene>) -> Vec<MeshRef> {
@@ -382,7 +442,7 @@ impl Parser<'_> {
             .collect();
         let index: HashMap<NodeId, usize> =
             refs.iter().enumerate().map(|(i, r)| (r.node, i)).collect();
-        for &(node, op, off) in &self.mesh_operands {
+        for (node, op, off) in graph.map(|g| self.mesh_operands(g)).unwrap_or_default() {
             if let Some(&i) = index.get(&node) {
                 refs[i].operand_of.push((op, place(off)));
             }

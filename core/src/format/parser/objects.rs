@@ -4,8 +4,8 @@
 use glam::{Mat4, Vec3};
 
 use super::super::lexer::TokKind;
-use super::Parser;
 use super::fields::block_comments;
+use super::{NodeSpan, Parser};
 use crate::scene::{
     Anchor, Comments, CsgOp, Graph, MeshSlot, Node, NodeId, NodeKind, TransformOp, validate,
 };
@@ -21,18 +21,18 @@ pub(super) enum OpenBlock {
 pub(super) struct ContainerFrame {
     node: NodeId,
     kind: Container,
-    keyword: usize,
     open: usize,
     count: usize,
-    material: Option<u32>,
+    /// The MaterialIndex in effect, with where its number (or the Material block) stands.
+    material: Option<(u32, usize)>,
 }
 
 pub(super) struct TransformFrame {
     node: NodeId,
-    keyword: usize,
     open: usize,
     ops: Vec<TransformOp>,
-    has_child: bool,
+    /// How many objects the file gives it (the rules judge how many were read).
+    objects: usize,
 }
 
 /// What a container block is: a Group and a CSG operation read alike but for these.
@@ -93,7 +93,6 @@ impl Parser<'_> {
         let mut stack = vec![OpenBlock::Container(ContainerFrame {
             node: root,
             kind: Container::Group { declared: None },
-            keyword: off,
             open,
             count: 0,
             material: None,
@@ -139,6 +138,8 @@ impl Parser<'_> {
                 }
             }
         }
+        // Blocks left open (the file ended): how many objects they hold is not known.
+        self.lost_objects.extend(stack.iter().map(OpenBlock::node));
         self.graph = Some(graph);
     }
 
@@ -171,9 +172,8 @@ impl Parser<'_> {
             ("MaterialIndex", _) => {
                 self.defer_comments();
                 if let Some((i, at)) = self.expect_count("MaterialIndex") {
-                    let i = u32::try_from(i).unwrap_or(u32::MAX);
-                    self.material_refs.push((i, at));
-                    frame.material = Some(i);
+                    self.material_refs.push((i as u64, at));
+                    frame.material = Some((u32::try_from(i).unwrap_or(u32::MAX), at));
                 }
             }
             // The lecture's shorthand: a Material placed in a Group adds it and applies it
@@ -181,7 +181,7 @@ impl Parser<'_> {
             ("Material", Container::Group { .. }) => {
                 if let Some(m) = self.parse_material_block("Material", at) {
                     self.materials.push(m);
-                    frame.material = Some((self.materials.len() - 1) as u32);
+                    frame.material = Some(((self.materials.len() - 1) as u32, at));
                 }
             }
             _ if OBJECT_KEYWORDS.contains(&w) => {
@@ -221,18 +221,13 @@ impl Parser<'_> {
         graph: &mut Graph,
     ) -> Option<OpenBlock> {
         if OBJECT_KEYWORDS.contains(&w) {
-            if frame.has_child {
-                self.error(
-                    at,
-                    "a Transform holds exactly one object; this is a second (wrap them in a Group)",
-                );
-            }
-            frame.has_child = true;
+            // A second one is the rules' to report (they know where it stands).
+            frame.objects += 1;
             return self.start_object(w, at, frame.node, None, graph);
         }
         let c = self.comments_here();
         let op = self.parse_op(w, at)?;
-        if frame.has_child {
+        if frame.objects > 0 {
             self.error(
                 at,
                 "transform operations must come before the Transform's object",
@@ -348,7 +343,7 @@ impl Parser<'_> {
         w: &str,
         off: usize,
         parent: NodeId,
-        material: Option<u32>,
+        material: Option<(u32, usize)>,
         graph: &mut Graph,
     ) -> Option<OpenBlock> {
         let before = self.comments_here();
@@ -357,18 +352,18 @@ impl Parser<'_> {
             // The arrays that grow with every object, fallibly: a scene too big for the
             // memory there is ends the parse with a message, not an abort.
             let id = crate::memory::fallibly(|| {
-                this.node_offsets
+                this.spans
                     .try_reserve(1)
                     .and_then(|()| this.leaf_offsets.try_reserve(1))
             })
             .map_err(|_| crate::memory::OutOfMemory {
                 what: "the scene's objects",
-                bytes: (this.node_offsets.len() * 24) as u64,
+                bytes: (this.spans.len() * 32) as u64,
             })
             .and_then(|()| {
                 graph.try_add(Node {
                     kind,
-                    material,
+                    material: material.map(|(i, _)| i),
                     children: Vec::new(),
                     comments,
                 })
@@ -385,7 +380,7 @@ impl Parser<'_> {
                 }
             };
             graph.push_child(parent, id);
-            this.record_offset(id, off);
+            this.record_span(id, off, material.map(|(_, at)| at));
             Some(id)
         };
         let only_comments_before = Comments {
@@ -405,7 +400,6 @@ impl Parser<'_> {
             return Some(OpenBlock::Container(ContainerFrame {
                 node,
                 kind,
-                keyword: off,
                 open,
                 count: 0,
                 material: None,
@@ -421,10 +415,9 @@ impl Parser<'_> {
                 )?;
                 Some(OpenBlock::Transform(TransformFrame {
                     node,
-                    keyword: off,
                     open,
                     ops: Vec::new(),
-                    has_child: false,
+                    objects: 0,
                 }))
             }
             _ => {
@@ -503,33 +496,22 @@ impl Parser<'_> {
             }
             _ => return None,
         };
-        if let Err(e) = validate::check_kind(&kind) {
-            self.error(off, e.message);
-            return None;
-        }
+        // Its numbers are judged with the whole graph (`Parser::finish`).
         Some((kind, comments))
     }
 
+    /// Closes a block. How many objects a Transform or CSG node holds and what they are
+    /// are the rules' to judge once the tree is read; a block that lost an object it gives
+    /// (misspelt, or unreadable) is marked, so that its count is not reported as well.
     fn close_frame(&mut self, frame: OpenBlock, graph: &mut Graph) {
+        let (node, written) = match &frame {
+            OpenBlock::Container(f) => (f.node, f.count),
+            OpenBlock::Transform(f) => (f.node, f.objects),
+        };
+        if graph.node(node).children.len() != written {
+            self.lost_objects.insert(node);
+        }
         match frame {
-            OpenBlock::Container(ContainerFrame {
-                node,
-                kind: Container::Csg(op),
-                keyword,
-                count,
-                ..
-            }) => {
-                if count != 2 {
-                    self.error(
-                        keyword,
-                        format!("{} needs exactly two operand objects (nest them for more), found {count}", op.name()),
-                    );
-                }
-                let operands = graph.node(node).children.clone();
-                for c in operands {
-                    self.check_operand(graph, c, op);
-                }
-            }
             OpenBlock::Container(ContainerFrame {
                 kind:
                     Container::Group {
@@ -544,16 +526,7 @@ impl Parser<'_> {
                 );
             }
             OpenBlock::Container(_) => {}
-            OpenBlock::Transform(TransformFrame {
-                node,
-                keyword,
-                ops,
-                has_child,
-                ..
-            }) => {
-                if !has_child {
-                    self.error(keyword, "Transform needs one object after its operations");
-                }
+            OpenBlock::Transform(TransformFrame { node, ops, .. }) => {
                 // Ops were checked one by one as read; their product is checked with the
                 // whole chain above it once the tree is complete.
                 graph.node_mut(node).kind = NodeKind::Transform(ops);
@@ -561,39 +534,10 @@ impl Parser<'_> {
         }
     }
 
-    fn record_offset(&mut self, id: NodeId, off: usize) {
-        if self.node_offsets.len() <= id.index() {
-            self.node_offsets.resize(id.index() + 1, 0);
+    fn record_span(&mut self, id: NodeId, keyword: usize, material: Option<usize>) {
+        if self.spans.len() <= id.index() {
+            self.spans.resize(id.index() + 1, NodeSpan::default());
         }
-        self.node_offsets[id.index()] = off;
-    }
-
-    /// An operand must bound a solid: follow Transforms down to the object they move.
-    fn check_operand(&mut self, graph: &Graph, id: NodeId, op: CsgOp) {
-        let mut cur = id;
-        while let Some(NodeKind::Transform(_)) = graph.get(cur).map(|n| &n.kind) {
-            match graph.node(cur).children.first() {
-                Some(&c) => cur = c,
-                // An empty Transform was reported when it closed.
-                None => return,
-            }
-        }
-        let at = self.node_offsets.get(cur.index()).copied().unwrap_or(0);
-        let Some(node) = graph.get(cur) else { return };
-        let name = op.name();
-        match &node.kind {
-            NodeKind::Sphere { .. } | NodeKind::Box { .. } | NodeKind::Plane { .. } | NodeKind::Csg(_) => {}
-            NodeKind::Triangle { .. } => self.error(
-                at,
-                format!("a lone Triangle is not a solid, so it cannot be an operand of {name} (use a closed TriangleMesh)"),
-            ),
-            NodeKind::Group => self.error(
-                at,
-                format!("a Group cannot be an operand of {name}: operands are solids (Sphere, Box, Plane, closed TriangleMesh, a Transform of one, or Union, Intersection, Subtraction); combine several with Union"),
-            ),
-            // Whether it is closed is known once it is loaded (the resolve step).
-            NodeKind::TriangleMesh { .. } => self.mesh_operands.push((cur, op, at)),
-            NodeKind::Transform(_) => {}
-        }
+        self.spans[id.index()] = NodeSpan { keyword, material };
     }
 }

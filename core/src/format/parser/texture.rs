@@ -187,7 +187,12 @@ impl Parser<'_> {
         if let Err(e) = validate::check_texture(&texture) {
             let at =
                 e.op.and_then(|i| op_offsets.get(i).copied())
-                    .or_else(|| offsets.iter().find(|(f, _)| *f == e.field).map(|x| x.1))
+                    .or_else(|| {
+                        offsets
+                            .iter()
+                            .find(|(f, _)| *f == e.field.name())
+                            .map(|x| x.1)
+                    })
                     .unwrap_or(off);
             self.error(at, format!("{kw}: {}", e.message));
             return None;

@@ -2,19 +2,27 @@
 //! [`Edit`]s (and, for a TriangleMesh's file, [`AppCommand::LoadMesh`]). Widgets edit copies;
 //! nothing here changes the document or reads files.
 
-use glam::{Mat4, Vec3};
-use tracelab_core::scene::{DEFAULT_ATTENUATION, LightKind};
-use tracelab_core::{
-    Background, Camera, CsgOp, Light, Material, MeshSlot, NodeId, NodeKind, Place, TransformOp,
-};
+//!
+//! In parts by job: this file the selection's dispatch and an object node's own fields,
+//! `scene_items.rs` the camera, lights and background, `material.rs` a material's colour,
+//! Phong fields and solid texture, `transform.rs` a Transform's ops.
+
+mod material;
+mod scene_items;
+mod transform;
+
+use glam::Vec3;
+use tracelab_core::{CsgOp, Field, Light, Material, MeshSlot, NodeId, NodeKind, Place};
 
 use crate::document::edit::Edit;
 use crate::document::{Document, Selection};
 use crate::gui::command::AppCommand;
 use crate::gui::drag_speed::{DragSpeeds, world_per_unit};
-use crate::gui::widgets::number;
 
-use super::fields::{color, op_id, refusal_note, scalar, show_refusal_for, vec3};
+use super::fields::{refusal_note, scalar, show_refusal_for, vec3};
+use material::material;
+use scene_items::{background, camera, light};
+use transform::transform_ops;
 
 pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
     let mut edits = Vec::new();
@@ -88,186 +96,6 @@ pub fn ui(ui: &mut egui::Ui, doc: &Document) -> Vec<AppCommand> {
         .collect()
 }
 
-fn camera(ui: &mut egui::Ui, cam: &Camera, edits: &mut Vec<Edit>) {
-    let speeds = DragSpeeds::for_scene_camera(cam);
-    ui.heading("Camera");
-    let mut c = cam.clone();
-    let mut changed = false;
-    ui.horizontal(|ui| {
-        let ortho = matches!(c, Camera::Orthographic { .. });
-        if ui.selectable_label(ortho, "Orthographic").clicked() && !ortho {
-            c = Camera::Orthographic {
-                center: c.center(),
-                direction: c.direction(),
-                up: c.up(),
-                size: 5.0,
-            };
-            changed = true;
-        }
-        if ui.selectable_label(!ortho, "Perspective").clicked() && ortho {
-            c = Camera::Perspective {
-                center: c.center(),
-                direction: c.direction(),
-                up: c.up(),
-                angle: 30.0,
-            };
-            changed = true;
-        }
-    });
-    match &mut c {
-        Camera::Orthographic {
-            center,
-            direction,
-            up,
-            size,
-        } => {
-            changed |= vec3(ui, "center", center, speeds.length(1.0));
-            changed |= vec3(ui, "direction", direction, 0.01);
-            changed |= vec3(ui, "up", up, 0.01);
-            changed |= scalar(ui, "size", size, DragSpeeds::factor(*size));
-        }
-        Camera::Perspective {
-            center,
-            direction,
-            up,
-            angle,
-        } => {
-            changed |= vec3(ui, "center", center, speeds.length(1.0));
-            changed |= vec3(ui, "direction", direction, 0.01);
-            changed |= vec3(ui, "up", up, 0.01);
-            changed |= scalar(ui, "angle (degrees)", angle, 0.1);
-            *angle = angle.clamp(0.1, 179.0);
-        }
-    }
-    if changed {
-        edits.push(Edit::SetCamera(c));
-    }
-}
-
-fn light(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
-    let Some(l) = doc.scene.lights().get(i) else {
-        return;
-    };
-    let mut l = l.clone();
-    show_refusal_for(ui, doc, Some(Place::Light(i)));
-    let mut changed = match &mut l.kind {
-        LightKind::Directional { direction } => {
-            ui.strong(format!("Light {i} (directional)"));
-            vec3(ui, "direction", direction, 0.01)
-        }
-        LightKind::Point {
-            position,
-            attenuation,
-        } => {
-            ui.strong(format!("Light {i} (point)"));
-            let mut changed = vec3(ui, "position", position, 0.01);
-            // Absent means the course's 1 0 0, and stays absent until given.
-            let mut on = attenuation.is_some();
-            if ui
-                .checkbox(&mut on, "attenuation (constant, linear, quadratic)")
-                .changed()
-            {
-                *attenuation = on.then_some(DEFAULT_ATTENUATION);
-                changed = true;
-            }
-            if let Some(a) = attenuation {
-                changed |= vec3(ui, "attenuation", a, 0.01);
-            }
-            changed
-        }
-    };
-    changed |= color(ui, "colour", &mut l.color);
-    if changed {
-        edits.push(Edit::SetLight { index: i, light: l });
-    }
-    if ui.button(format!("Remove light {i}")).clicked() {
-        edits.push(Edit::RemoveLight { index: i });
-    }
-}
-
-fn background(ui: &mut egui::Ui, bg: &Background, edits: &mut Vec<Edit>) {
-    ui.heading("Background");
-    let mut b = bg.clone();
-    let mut changed = false;
-    for (name, field) in [("colour", &mut b.color), ("ambient light", &mut b.ambient)] {
-        let mut on = field.is_some();
-        ui.horizontal(|ui| {
-            if ui.checkbox(&mut on, "").changed() {
-                *field = on.then_some(Vec3::ZERO);
-                changed = true;
-            }
-            if let Some(c) = field {
-                changed |= color(ui, name, c);
-            } else {
-                ui.label(format!("{name} (not set: black)"));
-            }
-        });
-    }
-    if changed {
-        edits.push(Edit::SetBackground(b));
-    }
-}
-
-fn material(ui: &mut egui::Ui, doc: &Document, i: usize, edits: &mut Vec<Edit>) {
-    let Some(m) = doc.scene.materials.get(i) else {
-        return;
-    };
-    let mut m = m.clone();
-    show_refusal_for(ui, doc, Some(Place::Material(i)));
-    ui.push_id(("material", i), |ui| {
-        if let Some(t) = &m.texture {
-            // Shown, not yet editable: the file's text is the way to change one.
-            texture_lines(ui, i, t);
-        } else {
-            color_and_phong(ui, i, &mut m, edits);
-        }
-        if ui
-            .button("Remove")
-            .on_hover_text(format!("Remove material {i}"))
-            .clicked()
-        {
-            edits.push(Edit::RemoveMaterial { index: i });
-        }
-    });
-}
-
-/// A solid texture, read-only: its kind, materials, numbers and Transform ops.
-fn texture_lines(ui: &mut egui::Ui, i: usize, t: &tracelab_core::SolidTexture) {
-    let [a, b] = t.materials;
-    ui.label(format!("{i}: {} of materials {a} and {b}", t.kind.name()));
-    if t.kind.has_octaves() {
-        ui.label(format!("octaves {}", t.octaves));
-    }
-    if t.kind.has_waves() {
-        ui.label(format!(
-            "frequency {}  amplitude {}",
-            t.frequency, t.amplitude
-        ));
-    }
-    for op in t.transform.iter().flatten() {
-        ui.small(format!("Transform: {}", op.summary()));
-    }
-    ui.small("(a solid texture: edit it in the scene file)");
-}
-
-fn color_and_phong(ui: &mut egui::Ui, i: usize, m: &mut Material, edits: &mut Vec<Edit>) {
-    {
-        // Remove under the colour, not beside it: beside, the row was wider than the panel
-        // and egui widened the inspector by 60 points, pushing the picture aside.
-        let mut c = m.diffuse;
-        if color(ui, &format!("{i}: diffuse"), &mut c) {
-            m.diffuse = c;
-            edits.push(Edit::SetMaterial {
-                index: i,
-                material: m.clone(),
-            });
-        }
-        if let Some(material) = super::phong::fields(ui, m) {
-            edits.push(Edit::SetMaterial { index: i, material });
-        }
-    }
-}
-
 fn node(
     ui: &mut egui::Ui,
     doc: &Document,
@@ -308,7 +136,7 @@ fn node(
                     ui.selectable_value(&mut chosen, Some(m), text(Some(m)));
                 }
             });
-        refusal_note(ui, "material");
+        refusal_note(ui, &Field::MaterialIndex);
         if chosen != current {
             edits.push(Edit::SetNodeMaterial {
                 node: id,
@@ -332,8 +160,8 @@ fn node(
             ui.label(format!("{} objects", n.children.len()));
         }
         NodeKind::Sphere { center, radius } => {
-            let mut c = vec3(ui, "center", center, len);
-            c |= scalar(ui, "radius", radius, len);
+            let mut c = vec3(ui, "center", Field::Center, center, len);
+            c |= scalar(ui, "radius", Field::Radius, radius, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -342,8 +170,8 @@ fn node(
             }
         }
         NodeKind::Plane { normal, offset } => {
-            let mut c = vec3(ui, "normal", normal, 0.01);
-            c |= scalar(ui, "offset", offset, len);
+            let mut c = vec3(ui, "normal", Field::Normal, normal, 0.01);
+            c |= scalar(ui, "offset", Field::Offset, offset, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -354,7 +182,7 @@ fn node(
         NodeKind::Triangle { vertices } => {
             let mut c = false;
             for (i, v) in vertices.iter_mut().enumerate() {
-                c |= vec3(ui, &format!("vertex{i}"), v, len);
+                c |= vec3(ui, &format!("vertex{i}"), Field::Vertex(i), v, len);
             }
             if c {
                 edits.push(Edit::SetNodeKind {
@@ -375,7 +203,7 @@ fn node(
             ui.horizontal(|ui| {
                 ui.label("obj_file");
                 ui.text_edit_singleline(&mut path);
-                refusal_note(ui, "obj_file");
+                refusal_note(ui, &Field::ObjFile);
             });
             if path == *obj_file {
                 ui.data_mut(|d| d.remove::<String>(buf_id));
@@ -414,8 +242,8 @@ fn node(
             }
         }
         NodeKind::Box { min, max } => {
-            let mut c = vec3(ui, "min", min, len);
-            c |= vec3(ui, "max", max, len);
+            let mut c = vec3(ui, "min", Field::Min, min, len);
+            c |= vec3(ui, "max", Field::Max, max, len);
             if c {
                 edits.push(Edit::SetNodeKind {
                     node: id,
@@ -451,129 +279,6 @@ fn node(
             }
         }
     }
-}
-
-fn op_names() -> [(&'static str, TransformOp); 8] {
-    [
-        ("Translate", TransformOp::Translate(Vec3::ZERO)),
-        ("Scale", TransformOp::Scale(Vec3::ONE)),
-        ("UniformScale", TransformOp::UniformScale(1.0)),
-        ("XRotate", TransformOp::XRotate(0.0)),
-        ("YRotate", TransformOp::YRotate(0.0)),
-        ("ZRotate", TransformOp::ZRotate(0.0)),
-        (
-            "Rotate",
-            TransformOp::Rotate {
-                axis: Vec3::Y,
-                degrees: 0.0,
-            },
-        ),
-        ("Matrix", TransformOp::Matrix(Mat4::IDENTITY)),
-    ]
-}
-
-/// `lengths[i]`: the drag speed of a length in the space op `i` acts in.
-fn transform_ops(
-    ui: &mut egui::Ui,
-    node: NodeId,
-    ops: &mut [TransformOp],
-    lengths: &[f64],
-    edits: &mut Vec<Edit>,
-) {
-    ui.label("Ops, first listed applied last (M = op1 · op2 · …):");
-    // The ops together (or the chain above them) flatten space.
-    refusal_note(ui, "ops");
-    let n = ops.len();
-    for (index, op) in ops.iter_mut().enumerate() {
-        ui.push_id(index, |ui| {
-            ui.data_mut(|d| d.insert_temp(op_id(), Some(index)));
-            ui.group(|ui| {
-                let len = lengths.get(index).copied().unwrap_or(0.02);
-                let changed = match op {
-                    TransformOp::Translate(v) => vec3(ui, "Translate", v, len),
-                    TransformOp::Scale(v) => {
-                        vec3(ui, "Scale", v, DragSpeeds::factor(v.abs().max_element()))
-                    }
-                    TransformOp::UniformScale(s) => {
-                        scalar(ui, "UniformScale", s, DragSpeeds::factor(*s))
-                    }
-                    TransformOp::XRotate(d) => scalar(ui, "XRotate (degrees)", d, 0.5),
-                    TransformOp::YRotate(d) => scalar(ui, "YRotate (degrees)", d, 0.5),
-                    TransformOp::ZRotate(d) => scalar(ui, "ZRotate (degrees)", d, 0.5),
-                    TransformOp::Rotate { axis, degrees } => {
-                        let a = vec3(ui, "Rotate axis", axis, 0.01);
-                        scalar(ui, "Rotate degrees", degrees, 0.5) || a
-                    }
-                    TransformOp::Matrix(m) => matrix(ui, m),
-                };
-                if changed {
-                    edits.push(Edit::SetTransformOp {
-                        node,
-                        index,
-                        op: op.clone(),
-                    });
-                }
-                ui.horizontal(|ui| {
-                    if ui.add_enabled(index > 0, egui::Button::new("Up")).clicked() {
-                        edits.push(Edit::MoveOp {
-                            node,
-                            from: index,
-                            to: index - 1,
-                        });
-                    }
-                    if ui
-                        .add_enabled(index + 1 < n, egui::Button::new("Down"))
-                        .clicked()
-                    {
-                        edits.push(Edit::MoveOp {
-                            node,
-                            from: index,
-                            to: index + 1,
-                        });
-                    }
-                    if ui.button("Remove").clicked() {
-                        edits.push(Edit::RemoveOp { node, index });
-                    }
-                });
-            });
-        });
-    }
-    ui.data_mut(|d| d.insert_temp(op_id(), None::<usize>));
-    ui.menu_button("Add op", |ui| {
-        for (name, op) in op_names() {
-            if ui.button(name).clicked() {
-                edits.push(Edit::AddOp { node, op });
-                ui.close();
-            }
-        }
-    });
-}
-
-/// A 4×4 matrix edited row by row, as the file writes it.
-fn matrix(ui: &mut egui::Ui, m: &mut Mat4) -> bool {
-    let mut changed = false;
-    ui.horizontal(|ui| {
-        ui.label("Matrix (rows)");
-        refusal_note(ui, "Matrix");
-    });
-    let mut rows = [
-        m.row(0).to_array(),
-        m.row(1).to_array(),
-        m.row(2).to_array(),
-        m.row(3).to_array(),
-    ];
-    egui::Grid::new("matrix").show(ui, |ui| {
-        for row in &mut rows {
-            for c in row.iter_mut() {
-                changed |= number(ui, c, |d| d.speed(0.01).max_decimals(4)).changed();
-            }
-            ui.end_row();
-        }
-    });
-    if changed {
-        *m = Mat4::from_cols_array_2d(&rows).transpose();
-    }
-    changed
 }
 
 /// "When does M·n happen to work?": the selected Transform's and the chain's similitude test.
