@@ -493,15 +493,21 @@ pub struct SingularTransform {
 
 /// Whether a world-from-object matrix (composed through the whole chain) can be used.
 pub fn check_world_from_object(m: &DMat4) -> Result<(), SingularTransform> {
-    let why = singular(DMat3::from_mat4(*m)).or_else(|| {
-        (!m.to_cols_array()
-            .iter()
-            .all(|v| v.abs() < f64::from(f32::MAX)))
-        .then_some("overflows")
-    });
-    match why {
+    match singular(DMat3::from_mat4(*m)) {
         Some(why) => Err(SingularTransform { why }),
-        None => Ok(()),
+        None => fits_f32(m),
+    }
+}
+
+/// Every entry of a world-from-object matrix within f32's range.
+fn fits_f32(m: &DMat4) -> Result<(), SingularTransform> {
+    if m.to_cols_array()
+        .iter()
+        .all(|v| v.abs() < f64::from(f32::MAX))
+    {
+        Ok(())
+    } else {
+        Err(SingularTransform { why: "overflows" })
     }
 }
 
@@ -649,10 +655,19 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
     let mut below: Option<usize> = None;
     for v in Walk::new(graph) {
         let (id, node, parent) = (v.id, v.node, v.parent);
+        let own_verdict = check_kind(&node.kind);
+        // A Transform right under the world whose own ops pass: its chain is those ops,
+        // already judged singular or not, so only f32's range is left (the load of a
+        // scene of many placed objects does not pay for the same test twice).
+        let chain_is_own = own_verdict.is_ok() && v.world_from_parent == DMat4::IDENTITY;
         if below.is_some_and(|d| v.depth > d) {
             // Inside a chain already reported.
         } else if let NodeKind::Transform(_) = &node.kind
-            && let Err(e) = check_world_from_object(&v.world_from_object)
+            && let Err(e) = if chain_is_own {
+                fits_f32(&v.world_from_object)
+            } else {
+                check_world_from_object(&v.world_from_object)
+            }
         {
             let message = e.to_string();
             chain.push(Problem {
@@ -683,7 +698,7 @@ pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
                 incomplete,
             })
         };
-        if let Err(e) = check_kind(&node.kind) {
+        if let Err(e) = own_verdict {
             own.insert(Place::Node(id));
             push(e.field, e.op, e.message, e.incomplete);
         }
