@@ -247,6 +247,21 @@ fn singular_transform_names_the_flattening_op() {
 }
 
 #[test]
+fn a_transform_s_first_broken_op_is_reported_at_its_place() {
+    // The rules judge a Transform's ops with its node: the first op at fault, where it stands.
+    let e = errors(&body(
+        "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  Translate 1 0 0\n  Scale 1 0 1\n  Rotate { 0 0 0 30 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",
+    ));
+    assert_eq!(
+        e,
+        [format!(
+            "{} singular transform: Scale(1, 0, 1) flattens space, so rays cannot be moved into object space",
+            at(6, 3)
+        )]
+    );
+}
+
+#[test]
 fn transform_with_two_objects_or_none_is_an_error() {
     let e = errors(&body(
         "Group {\n numObjects 1\n MaterialIndex 0\n Transform {\n  Sphere { center 0 0 0 radius 1 }\n  Sphere { center 0 0 0 radius 1 }\n }\n}\n",

@@ -1,4 +1,4 @@
-//! Which field a rule judges, by type: the rules in `validate.rs` name it, the parser turns
+//! Which field a rule judges, by type: the rules in `validate/` name it, the parser turns
 //! it into the place in the file, the editor's inspector shows the refusal beside the
 //! widget that edits the same `Field` (never by comparing label text).
 

@@ -168,6 +168,7 @@ pub fn parse_scene_unresolved(bytes: &[u8], name: &str) -> ParseOutcome {
         texture_refs: Vec::new(),
         leaf_offsets: Vec::new(),
         spans: Vec::new(),
+        op_offsets: Vec::new(),
         lost_objects: HashSet::new(),
         mesh_name_offsets: Vec::new(),
         last_obj_name: 0,
@@ -211,6 +212,8 @@ struct Parser<'a> {
     /// Where each node stands, indexed by node id: the rules' verdicts on the graph are
     /// placed with it.
     spans: Vec<NodeSpan>,
+    /// Where each Transform op stands, the ops of one Transform one after another.
+    op_offsets: Vec<usize>,
     /// Transform and CSG nodes that lost an object the file gives them (misspelt or
     /// unreadable, reported where it stands): their count of objects is not reported too.
     lost_objects: HashSet<NodeId>,
@@ -225,6 +228,8 @@ struct Parser<'a> {
 struct NodeSpan {
     keyword: usize,
     material: Option<usize>,
+    /// For a Transform: where its first op stands in `Parser::op_offsets`.
+    first_op: usize,
 }
 
 /// Where a texture's lines stand, for errors found once every material is read.
@@ -383,7 +388,14 @@ impl Parser<'_> {
             Field::Children if self.lost_objects.contains(&id) => None,
             Field::Child(c) => Some(span(*c).keyword),
             Field::MaterialIndex => Some(span(id).material.unwrap_or(span(id).keyword)),
-            _ => Some(span(id).keyword),
+            _ => Some(match p.op {
+                Some(i) => self
+                    .op_offsets
+                    .get(span(id).first_op + i)
+                    .copied()
+                    .unwrap_or(span(id).keyword),
+                None => span(id).keyword,
+            }),
         }
     }
 

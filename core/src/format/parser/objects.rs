@@ -226,7 +226,8 @@ impl Parser<'_> {
             return self.start_object(w, at, frame.node, None, graph);
         }
         let c = self.comments_here();
-        let op = self.parse_op(w, at)?;
+        // Its numbers are judged with the whole graph (`Parser::finish`), placed here.
+        let op = self.parse_op_numbers(w, at)?;
         if frame.objects > 0 {
             self.error(
                 at,
@@ -244,6 +245,7 @@ impl Parser<'_> {
                 .extend(c);
         }
         frame.ops.push(op);
+        self.op_offsets.push(at);
         None
     }
 
@@ -287,8 +289,9 @@ impl Parser<'_> {
         }
     }
 
-    /// Parses a transform op after its keyword. Reports and returns None on failure
-    /// (including an unknown keyword).
+    /// Parses a transform op after its keyword and checks it alone (a texture's; an
+    /// object's is judged with its node). Reports and returns None on failure (including
+    /// an unknown keyword).
     pub(super) fn parse_op(&mut self, w: &str, off: usize) -> Option<TransformOp> {
         let op = self.parse_op_numbers(w, off)?;
         if let Err(e) = validate::check_op(&op) {
@@ -538,6 +541,12 @@ impl Parser<'_> {
         if self.spans.len() <= id.index() {
             self.spans.resize(id.index() + 1, NodeSpan::default());
         }
-        self.spans[id.index()] = NodeSpan { keyword, material };
+        // A Transform's ops are read next, one after another: they start here.
+        let first_op = self.op_offsets.len();
+        self.spans[id.index()] = NodeSpan {
+            keyword,
+            material,
+            first_op,
+        };
     }
 }

@@ -1,15 +1,24 @@
 //! The validity rules of a scene, in one place: the parser applies them with file locations,
 //! the editor checks every edit with them before applying it, and the checked writer before
 //! it writes. A scene that passes them is one the writer can print and the parser read back.
+//!
+//! In parts: this file each item's own rules (camera, lights, background, materials,
+//! textures, a node's parameters, a Transform op) and the whole scene's; `graph.rs` the
+//! rules about the object graph as a whole; `tests.rs` their unit tests.
 
 use glam::{DMat3, DMat4, Vec3};
 
+mod graph;
+#[cfg(test)]
+mod tests;
+
+pub use graph::{check_graph, check_material_index, is_solid};
+
 use super::field::Field;
 use super::transform::{compose_f64, op_matrix_f64, unit};
-use super::walk::Walk;
 use super::words::{is_numberlike, is_word};
 use super::{
-    Background, Camera, Graph, Light, LightKind, MAX_OCTAVES, Material, NodeId, NodeKind, Scene,
+    Background, Camera, Light, LightKind, MAX_OCTAVES, Material, NodeId, NodeKind, Scene,
     SolidTexture, TransformOp,
 };
 
@@ -493,15 +502,21 @@ pub struct SingularTransform {
 
 /// Whether a world-from-object matrix (composed through the whole chain) can be used.
 pub fn check_world_from_object(m: &DMat4) -> Result<(), SingularTransform> {
-    let why = singular(DMat3::from_mat4(*m)).or_else(|| {
-        (!m.to_cols_array()
-            .iter()
-            .all(|v| v.abs() < f64::from(f32::MAX)))
-        .then_some("overflows")
-    });
-    match why {
+    match singular(DMat3::from_mat4(*m)) {
         Some(why) => Err(SingularTransform { why }),
-        None => Ok(()),
+        None => fits_f32(m),
+    }
+}
+
+/// Every entry of a world-from-object matrix within f32's range.
+fn fits_f32(m: &DMat4) -> Result<(), SingularTransform> {
+    if m.to_cols_array()
+        .iter()
+        .all(|v| v.abs() < f64::from(f32::MAX))
+    {
+        Ok(())
+    } else {
+        Err(SingularTransform { why: "overflows" })
     }
 }
 
@@ -586,177 +601,6 @@ pub fn check_kind(kind: &NodeKind) -> Result<(), Invalid> {
     Ok(())
 }
 
-/// Whether `id` bounds a solid (a CSG operand): Transforms are followed to what they move.
-pub fn is_solid(graph: &Graph, id: NodeId) -> bool {
-    not_a_solid(graph, id).is_none() && !ends_in_empty_transform(graph, id)
-}
-
-/// The object at the end of `id`'s Transforms, when it is not a solid: a Triangle or a
-/// Group. A Transform holding nothing is judged by its own rule, not here.
-fn not_a_solid(graph: &Graph, id: NodeId) -> Option<NodeId> {
-    let mut cur = id;
-    loop {
-        let node = graph.get(cur)?;
-        match &node.kind {
-            NodeKind::Transform(_) => cur = *node.children.first()?,
-            NodeKind::Triangle { .. } | NodeKind::Group => return Some(cur),
-            _ => return None,
-        }
-    }
-}
-
-fn ends_in_empty_transform(graph: &Graph, id: NodeId) -> bool {
-    let mut cur = id;
-    while let Some(n) = graph.get(cur) {
-        match (&n.kind, n.children.first()) {
-            (NodeKind::Transform(_), Some(&c)) => cur = c,
-            (NodeKind::Transform(_), None) => return true,
-            _ => return false,
-        }
-    }
-    true
-}
-
-/// A MaterialIndex (as written: a file may give one past `u32`) against the scene's
-/// materials.
-pub fn check_material_index(index: u64, n_materials: usize) -> Result<(), Invalid> {
-    if index < n_materials as u64 {
-        return Ok(());
-    }
-    let range = if n_materials == 0 {
-        "the scene has no materials".to_string()
-    } else {
-        format!("valid indices are 0 to {}", n_materials - 1)
-    };
-    Err(Invalid::new(
-        Field::MaterialIndex,
-        format!("MaterialIndex {index} is out of range: {range}"),
-    ))
-}
-
-/// Rules about the object graph: each node's parameters, Transform and CSG child counts,
-/// CSG operands that are solids, materials in range and placed where the file can say
-/// them, and every Transform's world-from-object matrix composed through its whole chain
-/// (not below a node whose own parameters are already at fault).
-pub fn check_graph(graph: &Graph, n_materials: usize) -> Vec<Problem> {
-    let mut out = Vec::new();
-    // Nodes whose own parameters break a rule: their chain says the same thing again.
-    let mut own = std::collections::HashSet::new();
-    // Every Transform's world-from-object matrix, composed in f64 through its whole chain
-    // of ancestors, in the same walk; only the outermost failing Transform of a chain is
-    // reported (`below`: its depth, while the walk is inside it).
-    let mut chain = Vec::new();
-    let mut below: Option<usize> = None;
-    for v in Walk::new(graph) {
-        let (id, node, parent) = (v.id, v.node, v.parent);
-        if below.is_some_and(|d| v.depth > d) {
-            // Inside a chain already reported.
-        } else if let NodeKind::Transform(_) = &node.kind
-            && let Err(e) = check_world_from_object(&v.world_from_object)
-        {
-            let message = e.to_string();
-            chain.push(Problem {
-                place: Place::Node(id),
-                field: Field::Ops,
-                op: None,
-                reason: message.clone(),
-                message,
-                incomplete: false,
-            });
-            below = Some(v.depth);
-        } else {
-            below = None;
-        }
-        let name = node.kind.name();
-        let mut push = |field: Field, op: Option<usize>, reason: String, incomplete: bool| {
-            // "Sphere (node #4): radius …", not "Sphere (node #4): Sphere: radius …".
-            let rest = reason
-                .strip_prefix(name)
-                .and_then(|r| r.strip_prefix(": "))
-                .unwrap_or(&reason);
-            out.push(Problem {
-                place: Place::Node(id),
-                field,
-                op,
-                message: format!("{name} (node #{}): {rest}", id.0),
-                reason: reason.clone(),
-                incomplete,
-            })
-        };
-        if let Err(e) = check_kind(&node.kind) {
-            own.insert(Place::Node(id));
-            push(e.field, e.op, e.message, e.incomplete);
-        }
-        if let Some(m) = node.material {
-            let parent_kind = parent.and_then(|p| graph.get(p)).map(|p| &p.kind);
-            if !matches!(parent_kind, Some(NodeKind::Group | NodeKind::Csg(_))) {
-                let m = format!(
-                    "MaterialIndex {m} can only be set on an object listed in a Group or CSG node"
-                );
-                push(Field::MaterialIndex, None, m, false);
-            }
-            if let Err(e) = check_material_index(u64::from(m), n_materials) {
-                push(e.field, None, e.message, false);
-            }
-        }
-        match &node.kind {
-            NodeKind::Transform(_) if node.children.is_empty() => {
-                let m = "Transform needs one object after its operations".to_string();
-                push(Field::Children, None, m, false);
-            }
-            NodeKind::Transform(_) => {
-                for &c in &node.children[1..] {
-                    let m = "a Transform holds exactly one object; this is a second (wrap them \
-                             in a Group)";
-                    push(Field::Child(c), None, m.into(), false);
-                }
-            }
-            NodeKind::Csg(op) => {
-                let op = op.name();
-                let n = node.children.len();
-                if n != 2 {
-                    let m = format!(
-                        "{op} needs exactly two operand objects (nest them for more), found {n}"
-                    );
-                    push(Field::Children, None, m, false);
-                }
-                for &c in &node.children {
-                    let Some(at) = not_a_solid(graph, c) else {
-                        continue;
-                    };
-                    let m = match graph.get(at).map(|n| &n.kind) {
-                        Some(NodeKind::Group) => format!(
-                            "a Group cannot be an operand of {op}: operands are solids (Sphere, \
-                             Box, Plane, closed TriangleMesh, a Transform of one, or Union, \
-                             Intersection, Subtraction); combine several with Union"
-                        ),
-                        _ => format!(
-                            "a lone Triangle is not a solid, so it cannot be an operand of {op} \
-                             (use a closed TriangleMesh)"
-                        ),
-                    };
-                    push(Field::Child(at), None, m, false);
-                }
-            }
-            _ => {}
-        }
-    }
-    out.extend(
-        chain
-            .into_iter()
-            .filter(|p| !own.contains(&p.place))
-            .map(|p| Problem {
-                message: format!(
-                    "Transform (node #{}): {}",
-                    p.node().map_or(0, |n| n.0),
-                    p.message
-                ),
-                ..p
-            }),
-    );
-    out
-}
-
 /// Every rule, over the whole scene.
 pub fn check_scene(scene: &Scene) -> Vec<Problem> {
     let mut out = Vec::new();
@@ -801,208 +645,4 @@ pub fn check_scene(scene: &Scene) -> Vec<Problem> {
     }
     out.extend(check_graph(&scene.graph, scene.materials.len()));
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::{MeshSlot, Node};
-    use super::*;
-    use glam::Mat4;
-
-    fn ts(ops: Vec<TransformOp>) -> Result<(), Invalid> {
-        check_kind(&NodeKind::Transform(ops))
-    }
-
-    #[test]
-    fn unit_survives_components_whose_square_overflows() {
-        assert_eq!(unit(Vec3::new(0.0, 0.0, 1e20)), Some(Vec3::Z));
-        assert_eq!(unit(Vec3::new(0.0, 0.0, -3e38)), Some(Vec3::NEG_Z));
-        let l = Vec3::new(-0.5, -1.0, -0.5);
-        assert!((unit(l * 1e20).expect("unit") - l.normalize()).length() < 1e-6);
-        assert_eq!(unit(Vec3::ZERO), None);
-        assert_eq!(unit(Vec3::new(f32::NAN, 0.0, 1.0)), None);
-    }
-
-    #[test]
-    fn singularity_is_relative_to_the_matrix_s_own_scale() {
-        assert!(ts(vec![TransformOp::UniformScale(0.0001)]).is_ok());
-        assert!(ts(vec![TransformOp::UniformScale(1e13)]).is_ok());
-        assert!(ts(vec![TransformOp::Scale(Vec3::new(1.0, 0.0, 1.0))]).is_err());
-        assert!(ts(vec![TransformOp::Scale(Vec3::new(1.0, 1e-8, 1.0))]).is_err());
-        assert!(ts(vec![TransformOp::UniformScale(0.0)]).is_err());
-        let e = ts(vec![
-            TransformOp::Translate(Vec3::X),
-            TransformOp::Scale(Vec3::new(1.0, 0.0, 1.0)),
-        ])
-        .expect_err("flat");
-        assert_eq!((e.field, e.op), (Field::Op("Scale"), Some(1)));
-    }
-
-    #[test]
-    fn a_projective_matrix_and_a_zero_rotate_axis_are_errors() {
-        let mut m = Mat4::IDENTITY.to_cols_array_2d();
-        m[0][3] = 0.5; // row 3, column 0
-        let e =
-            check_op(&TransformOp::Matrix(Mat4::from_cols_array_2d(&m))).expect_err("projective");
-        assert!(e.message.contains("last row must be 0 0 0 1"), "{e}");
-        let e = check_op(&TransformOp::Rotate {
-            axis: Vec3::ZERO,
-            degrees: 45.0,
-        })
-        .expect_err("zero axis");
-        assert!(e.message.contains("axis must not be zero"), "{e}");
-    }
-
-    #[test]
-    fn camera_rules_use_unit_vectors_and_name_their_field() {
-        let cam = |direction: Vec3, up: Vec3, size: f32| Camera::Orthographic {
-            center: Vec3::ZERO,
-            direction,
-            up,
-            size,
-        };
-        assert!(check_camera(&cam(Vec3::new(0.0, 0.0, -3e38), Vec3::Y, 1.0)).is_ok());
-        assert_eq!(
-            check_camera(&cam(Vec3::Y * 2.0, Vec3::Y, 1.0))
-                .expect_err("parallel")
-                .field,
-            Field::Up
-        );
-        assert_eq!(
-            check_camera(&cam(Vec3::NEG_Z, Vec3::Y, 0.0))
-                .expect_err("size 0")
-                .field,
-            Field::Size
-        );
-        assert_eq!(
-            check_camera(&cam(Vec3::NEG_Z, Vec3::Y, f32::NAN))
-                .expect_err("nan")
-                .field,
-            Field::Size
-        );
-    }
-
-    #[test]
-    fn negative_radius_and_empty_mesh_file_differ_in_kind() {
-        let e = check_kind(&NodeKind::Sphere {
-            center: Vec3::ZERO,
-            radius: -1.0,
-        })
-        .expect_err("negative");
-        assert!(
-            !e.incomplete,
-            "a negative radius is invalid, not incomplete"
-        );
-        let mesh = |f: &str| NodeKind::TriangleMesh {
-            obj_file: f.into(),
-            mesh: MeshSlot::Failed(String::new()),
-        };
-        assert!(check_kind(&mesh("")).expect_err("no file").incomplete);
-        assert!(!check_kind(&mesh("a b.obj")).expect_err("space").incomplete);
-        assert!(
-            check_kind(&mesh("1.obj")).is_ok(),
-            "the reader takes any word after obj_file"
-        );
-    }
-
-    #[test]
-    fn material_field_names_must_read_back_as_fields() {
-        let with = |name: &str| Material {
-            extra: vec![(name.into(), vec![1.0])],
-            ..Material::diffuse(Vec3::ONE)
-        };
-        assert!(check_material(&with("exponent")).is_ok());
-        for bad in [
-            "",
-            "2x",
-            "-e",
-            "nan",
-            "obj_file",
-            "diffuseColor",
-            "a b",
-            "x}",
-        ] {
-            assert!(check_material(&with(bad)).is_err(), "{bad:?}");
-        }
-    }
-
-    #[test]
-    fn graph_verdicts_name_the_child_at_fault_by_field() {
-        let sphere = || {
-            Node::new(NodeKind::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            })
-        };
-        // A Transform of two objects: the second is named, where the parser places it.
-        let mut g = Graph::new();
-        let t = g.add(Node::new(NodeKind::Transform(Vec::new())));
-        let (a, b) = (g.add(sphere()), g.add(sphere()));
-        g.push_child(g.root(), t);
-        g.push_child(t, a);
-        g.push_child(t, b);
-        let p = check_graph(&g, 0);
-        assert_eq!(p.len(), 1, "{p:?}");
-        assert_eq!(
-            (p[0].place, &p[0].field),
-            (Place::Node(t), &Field::Child(b))
-        );
-        // A CSG operand through a Transform: the Triangle it leads to is named.
-        let mut g = Graph::new();
-        let u = g.add(Node::new(NodeKind::Csg(super::super::CsgOp::Union)));
-        let t = g.add(Node::new(NodeKind::Transform(Vec::new())));
-        let tri = g.add(Node::new(NodeKind::Triangle {
-            vertices: [Vec3::ZERO, Vec3::X, Vec3::Y],
-        }));
-        let s = g.add(sphere());
-        g.push_child(g.root(), u);
-        g.push_child(u, t);
-        g.push_child(t, tri);
-        g.push_child(u, s);
-        let p = check_graph(&g, 0);
-        assert_eq!(p.len(), 1, "{p:?}");
-        assert_eq!(
-            (p[0].place, &p[0].field),
-            (Place::Node(u), &Field::Child(tri))
-        );
-        assert!(
-            p[0].reason.starts_with("a lone Triangle is not a solid"),
-            "{p:?}"
-        );
-        assert!(!is_solid(&g, t) && is_solid(&g, s));
-    }
-
-    #[test]
-    fn nested_tiny_scales_are_fine_and_a_flattening_one_is_found_in_the_chain() {
-        let mut g = Graph::new();
-        let mut parent = g.root();
-        for _ in 0..10 {
-            let t = g.add(Node::new(NodeKind::Transform(vec![
-                TransformOp::UniformScale(0.1),
-            ])));
-            g.push_child(parent, t);
-            parent = t;
-        }
-        let s = g.add(Node::new(NodeKind::Sphere {
-            center: Vec3::ZERO,
-            radius: 1e10,
-        }));
-        g.push_child(parent, s);
-        assert_eq!(check_graph(&g, 0), []);
-        // Two ops, each fine alone, that squash y by 1e-8 together.
-        let mut g = Graph::new();
-        let ops = vec![TransformOp::Scale(Vec3::new(1.0, 1e-4, 1.0))];
-        let a = g.add(Node::new(NodeKind::Transform(ops.clone())));
-        let b = g.add(Node::new(NodeKind::Transform(ops)));
-        let s = g.add(Node::new(NodeKind::Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-        }));
-        g.push_child(g.root(), a);
-        g.push_child(a, b);
-        g.push_child(b, s);
-        let p = check_graph(&g, 0);
-        assert_eq!(p.len(), 1, "{p:?}");
-        assert_eq!(p[0].place, Place::Node(b));
-    }
 }
