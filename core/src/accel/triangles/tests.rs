@@ -77,6 +77,16 @@ fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray
             bvh.closest_hit_portable(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY),
             "ray {k}"
         );
+        // And so must the AVX kernels, which an AVX-512 CPU does not pick by itself.
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::detected() >= crate::simd::Level::Avx {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX.
+            let avx = unsafe {
+                bvh.closest_hit_avx(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY)
+            };
+            assert_eq!(a, avx, "ray {k}, avx");
+        }
         let b = brute(pos, tris, ray, 0.0);
         match (a, b) {
             (None, None) => {}
@@ -416,6 +426,22 @@ fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8
                 got.map(|h| h.map(|h| h.t)),
                 "sparse, packet {p}"
             );
+            // Where the CPU has AVX-512 the packet above ran its kernels; the AVX ones (what
+            // TRACELAB_SIMD=avx picks) agree with them bit for bit, in the same run.
+            #[cfg(target_arch = "x86_64")]
+            if crate::simd::detected() >= crate::simd::Level::Avx512 {
+                let mut t_avx = limits;
+                #[allow(unsafe_code)]
+                // SAFETY: the CPU has AVX-512, so AVX too.
+                let avx =
+                    unsafe { bvh.packet_avx(&o, &d, active, t_min, &mut t_avx, false, false) };
+                assert_eq!(
+                    t_avx.map(f32::to_bits),
+                    t_packet.map(f32::to_bits),
+                    "avx, packet {p}"
+                );
+                assert_eq!(avx, got, "avx, packet {p}");
+            }
             // The portable fallback (single rays) agrees too.
             let mut t_singles = limits;
             let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
