@@ -11,7 +11,7 @@ use super::avx::{self, load_row, load8, slab_tail, store8};
 #[cfg(target_arch = "x86_64")]
 use super::traverse::nearest_first;
 #[cfg(target_arch = "x86_64")]
-use super::{SLAB_WIDEN, avx512, has_avx, has_avx512};
+use super::{SLAB_WIDEN, has_avx};
 use super::{TriangleBvh, TriangleHit};
 use crate::accel::wide::WIDTH;
 #[cfg(target_arch = "x86_64")]
@@ -68,7 +68,7 @@ impl TriangleBvh {
         if has_avx() {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX, checked just above.
-            return unsafe { self.packet_avx(o, d, active, t_min, t_max, sparse, has_avx512()) };
+            return unsafe { self.packet_avx(o, d, active, t_min, t_max, sparse) };
         }
         let _ = sparse;
         self.singles8(o, d, active, t_min, t_max)
@@ -100,14 +100,9 @@ impl TriangleBvh {
     /// exact under rounding, see `PacketBounds`), so a box is entered whenever any ray's own
     /// slab test would enter it; at a leaf, each ray whose own slab test (the single-ray
     /// one, bit for bit) enters the leaf's box runs the AVX leaf test with its own t_best.
-    /// With `wide_leaves` (only where the CPU has AVX-512 F and VL), two or more rays
-    /// entering a leaf go through `avx512::leaf_rays` instead, two at a time: one call per
-    /// leaf, as that function cannot be inlined into this AVX one (a second traversal
-    /// compiled for AVX-512, generic over the leaf test, stopped LLVM inlining the packet's
-    /// box tests and cost 7% with the AVX kernels, `docs/perf.md`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    pub(super) fn packet_avx(
+    fn packet_avx(
         &self,
         o: &[Vec3A; WIDTH],
         d: &[Vec3A; WIDTH],
@@ -115,7 +110,6 @@ impl TriangleBvh {
         t_min: f32,
         t_max: &mut [f32; WIDTH],
         sparse: bool,
-        wide_leaves: bool,
     ) -> [Option<TriangleHit>; WIDTH] {
         let mut out = [None; WIDTH];
         if self.nodes.is_empty() || active == 0 {
@@ -135,7 +129,6 @@ impl TriangleBvh {
             }
         }
         let mut t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-
         let mut best = [usize::MAX; WIDTH];
         let mut stack: RayStack<(Child, f32, u32)> = RayStack::new();
         let mut t_enter = [0.0f32; WIDTH];
@@ -168,23 +161,6 @@ impl TriangleBvh {
                     }
                 }
                 let mut hit = false;
-                if wide_leaves && rays & (rays - 1) != 0 {
-                    #[allow(unsafe_code)]
-                    // SAFETY: callers set `wide_leaves` only where the CPU has AVX-512 F and VL.
-                    let got = unsafe {
-                        avx512::leaf_rays(
-                            self,
-                            (o, d),
-                            &p,
-                            rays,
-                            (first, count),
-                            t_min,
-                            &mut t_best,
-                            &mut best,
-                        )
-                    };
-                    (hit, rays) = got;
-                }
                 while rays != 0 {
                     let i = rays.trailing_zeros() as usize;
                     rays &= rays - 1;
@@ -253,7 +229,7 @@ pub(super) struct PacketBounds {
     inv_min: [f32; 3],
     inv_max: [f32; 3],
     /// Per axis, lane i = ray i's origin and reciprocal direction.
-    pub(super) o: [__m256; 3],
+    o: [__m256; 3],
     inv: [__m256; 3],
 }
 

@@ -426,22 +426,6 @@ fn assert_packets_agree(bvh: &TriangleBvh, rays: &[Ray], t_min: f32, masks: &[u8
                 got.map(|h| h.map(|h| h.t)),
                 "sparse, packet {p}"
             );
-            // Where the CPU has AVX-512 the packet above ran its kernels; the AVX ones (what
-            // TRACELAB_SIMD=avx picks) agree with them bit for bit, in the same run.
-            #[cfg(target_arch = "x86_64")]
-            if crate::simd::detected() >= crate::simd::Level::Avx512 {
-                let mut t_avx = limits;
-                #[allow(unsafe_code)]
-                // SAFETY: the CPU has AVX-512, so AVX too.
-                let avx =
-                    unsafe { bvh.packet_avx(&o, &d, active, t_min, &mut t_avx, false, false) };
-                assert_eq!(
-                    t_avx.map(f32::to_bits),
-                    t_packet.map(f32::to_bits),
-                    "avx, packet {p}"
-                );
-                assert_eq!(avx, got, "avx, packet {p}");
-            }
             // The portable fallback (single rays) agrees too.
             let mut t_singles = limits;
             let singles = bvh.singles8(&o, &d, active, t_min, &mut t_singles);
