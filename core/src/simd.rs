@@ -1,6 +1,7 @@
 //! Which vector instructions the kernels use: the widest the CPU has, chosen once at run
-//! time, or a narrower one named by `TRACELAB_SIMD` (`sse`, `avx`), so tests and benchmarks
-//! run every path this machine supports. A wider level than the CPU has is never used.
+//! time, or a narrower one named by `TRACELAB_SIMD` (`sse`, `avx`, `avx512`), so tests and
+//! benchmarks run every path this machine supports. A wider level than the CPU has is never
+//! used: asking for one gives the widest the CPU has.
 
 use std::sync::OnceLock;
 
@@ -10,6 +11,9 @@ pub enum Level {
     Sse,
     /// 8-wide AVX.
     Avx,
+    /// AVX-512 (F and VL): 16-wide registers and mask registers, for the kernels that have
+    /// such a version (a packet's rays two at a time against a leaf); the others run AVX.
+    Avx512,
 }
 
 impl Level {
@@ -17,12 +21,19 @@ impl Level {
         match self {
             Level::Sse => "sse",
             Level::Avx => "avx",
+            Level::Avx512 => "avx512",
         }
     }
 }
 
 /// The widest level the CPU has.
 pub fn detected() -> Level {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+    {
+        return Level::Avx512;
+    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         return Level::Avx;
@@ -43,9 +54,10 @@ fn choose(asked: Option<&str>, cpu: Level) -> Level {
         None | Some("") => return cpu,
         Some("sse") => Level::Sse,
         Some("avx") => Level::Avx,
+        Some("avx512") => Level::Avx512,
         Some(other) => {
             log::warn!(
-                "TRACELAB_SIMD={other:?} is not one of sse, avx; using {}",
+                "TRACELAB_SIMD={other:?} is not one of sse, avx, avx512; using {}",
                 cpu.name()
             );
             return cpu;
@@ -73,6 +85,11 @@ mod tests {
         assert_eq!(choose(Some("sse"), Level::Avx), Level::Sse);
         assert_eq!(choose(Some("avx"), Level::Sse), Level::Sse);
         assert_eq!(choose(Some("avx512"), Level::Avx), Level::Avx);
+        assert_eq!(choose(Some("avx512"), Level::Sse), Level::Sse);
         assert_eq!(choose(Some("avx"), Level::Avx), Level::Avx);
+        assert_eq!(choose(None, Level::Avx512), Level::Avx512);
+        assert_eq!(choose(Some("avx512"), Level::Avx512), Level::Avx512);
+        assert_eq!(choose(Some("avx"), Level::Avx512), Level::Avx);
+        assert_eq!(choose(Some("sse"), Level::Avx512), Level::Sse);
     }
 }

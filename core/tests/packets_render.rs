@@ -87,6 +87,7 @@ fn the_kernels_are_the_ones_tracelab_simd_asks_for() {
     let want = match std::env::var("TRACELAB_SIMD").as_deref() {
         Ok("sse") => Level::Sse,
         Ok("avx") => Level::Avx.min(detected()),
+        Ok("avx512") => Level::Avx512.min(detected()),
         _ => detected(),
     };
     eprintln!(

@@ -9,6 +9,8 @@
 //!   every hit (for CSG).
 //! - `avx`: the AVX kernels (a ray against eight boxes, against a leaf's eight triangles);
 //!   their `unsafe` is only in `load8`, `store8` and `load_row`.
+//! - `avx512`: the leaf test with AVX-512 mask registers, for the single-ray traversal
+//!   compiled for AVX-512 (`closest_hit_avx512`, `any_hit_avx512`).
 //! - `packet`: eight coherent rays at once (`closest_hit8`, for `tracelab bench --packets`).
 
 use glam::{Vec3, Vec3A};
@@ -18,6 +20,8 @@ use crate::geometry::{Aabb, moller_trumbore};
 
 #[cfg(target_arch = "x86_64")]
 mod avx;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod build;
 mod check;
 mod packet;
@@ -106,6 +110,13 @@ fn finite_ray(o: Vec3A, d: Vec3A) -> bool {
 #[inline(always)]
 fn has_avx() -> bool {
     crate::simd::level() >= crate::simd::Level::Avx
+}
+
+/// Whether the AVX-512 kernels run here (the CPU has AVX-512 F and VL, and `TRACELAB_SIMD`
+/// does not ask for less).
+#[inline(always)]
+fn has_avx512() -> bool {
+    crate::simd::level() >= crate::simd::Level::Avx512
 }
 
 /// Nine component arrays of this length hold `n` triangles, padded so an 8-lane load at the

@@ -77,6 +77,16 @@ fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray
             bvh.closest_hit_portable(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY),
             "ray {k}"
         );
+        // And so must the AVX kernels, which an AVX-512 CPU does not pick by itself.
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::detected() >= crate::simd::Level::Avx {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX.
+            let avx = unsafe {
+                bvh.closest_hit_avx(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY)
+            };
+            assert_eq!(a, avx, "ray {k}, avx");
+        }
         let b = brute(pos, tris, ray, 0.0);
         match (a, b) {
             (None, None) => {}
