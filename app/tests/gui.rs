@@ -32,19 +32,7 @@ fn temp_dir(tag: &str) -> PathBuf {
 }
 
 fn harness(scene: Option<PathBuf>, size: (u32, u32)) -> Harness<'static, TracelabApp> {
-    Harness::builder()
-        .with_size(egui::vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene,
-                    fixed_size: Some(size),
-                    ..AppOptions::default()
-                },
-            )
-        })
+    common::app_harness(scene, size)
 }
 
 /// The first Transform in the scene whose first op is a Translate.

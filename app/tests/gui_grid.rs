@@ -9,14 +9,13 @@ mod common;
 use common::settle;
 use std::path::PathBuf;
 
-use egui::vec2;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::{UVec3, Vec3};
+use tracelab::gui::TracelabApp;
 use tracelab::gui::command::AppCommand;
 use tracelab::gui::grid_view::{GridSettings, box_path};
 use tracelab::gui::ray_diagram::{Role, Shape};
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab_core::{CompiledScene, MeshCache, RenderSettings, View};
 
 const SIZE: (u32, u32) = (160, 160);
@@ -30,21 +29,7 @@ fn harness() -> Harness<'static, TracelabApp> {
 }
 
 fn harness_on(scene: PathBuf) -> Harness<'static, TracelabApp> {
-    let mut h = Harness::builder()
-        .with_size(vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some(SIZE),
-                    ..AppOptions::default()
-                },
-            )
-        });
-    settle(&mut h);
-    h
+    common::settled_harness(Some(scene), SIZE)
 }
 
 /// The scene compiled by the library, with a grid of `cells` when given.

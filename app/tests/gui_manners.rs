@@ -17,21 +17,7 @@ use tracelab::gui::{AppOptions, Pending, TracelabApp};
 use tracelab_core::{NodeId, NodeKind, TransformOp};
 
 fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some((16, 16)),
-                    ..AppOptions::default()
-                },
-            )
-        });
-    settle(&mut h);
-    h
+    common::settled_harness(Some(scene), (16, 16))
 }
 
 /// A private copy of `scenes/sheared_sphere.txt` (Ctrl+S writes it).

@@ -12,11 +12,11 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::Vec3;
 use tracelab::document::Selection;
+use tracelab::gui::TracelabApp;
 use tracelab::gui::gizmo::Handle;
 use tracelab::gui::on_screen::OnScreen;
 use tracelab::gui::ray_diagram::{Role, diagrams};
 use tracelab::gui::view_tools::ViewTools;
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab_core::render::{RayStory, Secondary, inspect_pixel};
 use tracelab_core::scene::LightKind;
 use tracelab_core::{CompiledScene, MeshCache, RenderSettings, Scene};
@@ -30,21 +30,7 @@ fn mirror_glass(tag: &str) -> PathBuf {
 }
 
 fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
-    let mut h = Harness::builder()
-        .with_size(vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some((160, 160)),
-                    ..AppOptions::default()
-                },
-            )
-        });
-    settle(&mut h);
-    h
+    common::settled_harness(Some(scene), (160, 160))
 }
 
 fn select(h: &mut Harness<'static, TracelabApp>, s: Selection) {

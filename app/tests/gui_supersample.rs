@@ -5,29 +5,15 @@ mod common;
 use common::settle;
 
 use egui_kittest::Harness;
+use tracelab::gui::TracelabApp;
 use tracelab::gui::command::AppCommand;
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab_core::render::{Filter, Sampler, SamplerKind, Supersampling};
 use tracelab_core::{CompiledScene, MeshCache, RenderSettings};
 
 const SIZE: (u32, u32) = (160, 160);
 
 fn harness(scene: std::path::PathBuf) -> Harness<'static, TracelabApp> {
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some(SIZE),
-                    ..AppOptions::default()
-                },
-            )
-        });
-    settle(&mut h);
-    h
+    common::settled_harness(Some(scene), SIZE)
 }
 
 #[test]

@@ -9,24 +9,12 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use tracelab::document::Selection;
+use tracelab::gui::TracelabApp;
 use tracelab::gui::command::AppCommand;
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab_core::{NodeKind, ObjectRays};
 
 fn harness(size: (u32, u32)) -> Harness<'static, TracelabApp> {
-    Harness::builder()
-        .with_size(egui::vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: None,
-                    fixed_size: Some(size),
-                    ..AppOptions::default()
-                },
-            )
-        })
+    common::app_harness(None, size)
 }
 
 fn depth_t_index() -> usize {

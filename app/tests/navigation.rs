@@ -11,11 +11,11 @@ use egui::{Event, Modifiers, PointerButton, Pos2, vec2};
 use egui_kittest::Harness;
 use glam::Vec3;
 use tracelab::document::Selection;
+use tracelab::gui::TracelabApp;
 use tracelab::gui::command::AppCommand;
 use tracelab::gui::gizmo::{Axes, Handle};
 use tracelab::gui::on_screen::OnScreen;
 use tracelab::gui::view_tools::ViewTools;
-use tracelab::gui::{AppOptions, TracelabApp};
 use tracelab::navigation::ViewBasis;
 use tracelab_core::{Camera, MeshCache, NodeId, NodeKind, TransformOp};
 
@@ -41,21 +41,7 @@ const SPHERE: &str = "Sphere { center 0 0 0 radius 1 }";
 const SCALED: &str = "Transform { UniformScale 5 Transform { Translate 0.1 0 0 Sphere { center 0 0 0 radius 0.1 } } }";
 
 fn harness(scene: PathBuf) -> Harness<'static, TracelabApp> {
-    let mut h = Harness::builder()
-        .with_size(vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some(SIZE),
-                    ..AppOptions::default()
-                },
-            )
-        });
-    settle(&mut h);
-    h
+    common::settled_harness(Some(scene), SIZE)
 }
 
 fn camera(h: &Harness<'static, TracelabApp>) -> Camera {

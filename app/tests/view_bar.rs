@@ -40,20 +40,7 @@ fn scene_file(tag: &str, text: &str) -> PathBuf {
 }
 
 fn harness(scene: &Path, size: (u32, u32)) -> Harness<'static, TracelabApp> {
-    let scene = scene.to_path_buf();
-    Harness::builder()
-        .with_size(egui::vec2(1200.0, 760.0))
-        .with_max_steps(10_000)
-        .build_eframe(move |cc| {
-            TracelabApp::new(
-                Some(cc),
-                AppOptions {
-                    scene: Some(scene),
-                    fixed_size: Some(size),
-                    ..AppOptions::default()
-                },
-            )
-        })
+    common::app_harness(Some(scene.to_path_buf()), size)
 }
 
 fn click(h: &mut Harness<'static, TracelabApp>, label: &str) {

@@ -50,3 +50,36 @@ pub fn settle(h: &mut egui_kittest::Harness<'static, tracelab::gui::TracelabApp>
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
 }
+
+/// The editor in a 1200×760 window as the kittests drive it: `scene` opened (or the built-in
+/// one), the render at the fixed `size`; not yet stepped.
+#[cfg(feature = "gui")]
+pub fn app_harness(
+    scene: Option<PathBuf>,
+    size: (u32, u32),
+) -> egui_kittest::Harness<'static, tracelab::gui::TracelabApp> {
+    egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .with_max_steps(10_000)
+        .build_eframe(move |cc| {
+            tracelab::gui::TracelabApp::new(
+                Some(cc),
+                tracelab::gui::AppOptions {
+                    scene,
+                    fixed_size: Some(size),
+                    ..tracelab::gui::AppOptions::default()
+                },
+            )
+        })
+}
+
+/// `app_harness`, stepped until the scene is read and rendered (`settle`).
+#[cfg(feature = "gui")]
+pub fn settled_harness(
+    scene: Option<PathBuf>,
+    size: (u32, u32),
+) -> egui_kittest::Harness<'static, tracelab::gui::TracelabApp> {
+    let mut h = app_harness(scene, size);
+    settle(&mut h);
+    h
+}
