@@ -140,11 +140,13 @@ impl CompiledTexture {
         let w = match self.kind {
             TextureKind::Checkerboard => return if checker_is_b(q) { 1.0 } else { 0.0 },
             // N is within about ±1 (±2 summed over octaves) and mostly within ±0.5: centred
-            // on an even blend, clamped.
-            TextureKind::Noise => 0.5 + turbulence(q, self.octaves),
+            // on an even blend, clamped. Noise and Marble give material A the weight
+            // 0.5 + N and (1 + sin)/2, so B the rest, as the students' programs that agree
+            // on output7_03a do (README, "Solid textures").
+            TextureKind::Noise => 0.5 - turbulence(q, self.octaves),
             TextureKind::Marble => {
                 let s = self.frequency * q.x + self.amplitude * turbulence(q, self.octaves);
-                0.5 + 0.5 * s.sin()
+                0.5 - 0.5 * s.sin()
             }
             // Rings about the texture's y axis, bent by N.
             TextureKind::Wood => {
@@ -273,13 +275,24 @@ mod tests {
             }
             assert!((0.0..=1.0).contains(&c.weight(glam::Vec3::INFINITY)));
         }
-        // Marble with no noise is the pure sine of x: 0.5 at x = 0.
+        // Marble with no noise is the pure sine of x: 0.5 at x = 0; where sin is 1 it is
+        // all A (weight of B 0), where sin is -1 all B.
         let mut m = SolidTexture::new(TextureKind::Marble, 0, 1);
         m.octaves = 0;
         m.frequency = 1.0;
         let c = CompiledTexture::new(&m);
         assert!((c.weight(glam::Vec3::new(0.0, 5.0, 5.0)) - 0.5).abs() < 1e-6);
         let top = c.weight(glam::Vec3::new(std::f32::consts::FRAC_PI_2, 0.0, 0.0));
-        assert!((top - 1.0).abs() < 1e-6);
+        assert!(top.abs() < 1e-6, "{top}");
+        let bottom = c.weight(glam::Vec3::new(-std::f32::consts::FRAC_PI_2, 0.0, 0.0));
+        assert!((bottom - 1.0).abs() < 1e-6, "{bottom}");
+        // Noise: 0.5 + N is A's weight, so B's is 0.5 - N (0.5 on the lattice, where N = 0).
+        let mut n = SolidTexture::new(TextureKind::Noise, 0, 1);
+        n.octaves = 3;
+        let c = CompiledTexture::new(&n);
+        assert!((c.weight(glam::Vec3::new(1.0, 2.0, 3.0)) - 0.5).abs() < 1e-6);
+        let q = glam::Vec3::new(0.3, 0.7, 0.2);
+        let expect = (0.5 - turbulence(q.as_dvec3(), 3)).clamp(0.0, 1.0) as f32;
+        assert!((c.weight(q) - expect).abs() < 1e-6);
     }
 }
