@@ -5,6 +5,7 @@ mod common;
 use common::settle;
 
 use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
 use tracelab::gui::TracelabApp;
 use tracelab::gui::command::AppCommand;
 use tracelab_core::render::{Filter, Sampler, SamplerKind, Supersampling};
@@ -59,4 +60,35 @@ fn supersampling_renders_the_filtered_film_on_screen() {
         "View › Supersampling changed nothing on screen"
     );
     assert_eq!(after, library(Some(ss)));
+}
+
+/// 36 samples a pixel on a 1400×1400 view pass the cap of samples in an image: the renderer
+/// keeps the one-ray image, and the view says so (it was only in the log). Control: the same
+/// choice on a small view is no warning.
+#[test]
+fn supersampling_past_its_caps_is_said_over_the_view() {
+    let ss = Supersampling {
+        sampler: Sampler::new(SamplerKind::Jittered, 36, 6837).expect("a valid sampler"),
+        filter: Filter::default(),
+    };
+    let warned = |h: &Harness<'static, TracelabApp>| {
+        h.query_by_label_contains("View › Supersampling at")
+            .is_some()
+    };
+    let mut small = common::settled_harness(None, SIZE);
+    small
+        .state_mut()
+        .queue(AppCommand::SetSupersampling(Some(ss)));
+    settle(&mut small);
+    assert!(!warned(&small), "a view within the caps is warned about");
+
+    let mut big = common::settled_harness(None, (1400, 1400));
+    assert!(!warned(&big), "warned before supersampling was asked for");
+    big.state_mut()
+        .queue(AppCommand::SetSupersampling(Some(ss)));
+    settle(&mut big);
+    assert!(
+        warned(&big),
+        "36 samples × 1400×1400 pixels pass the cap and nothing on screen says so"
+    );
 }

@@ -119,10 +119,11 @@ pub fn disk_changed(ctx: &egui::Context, over: egui::Rect) -> Option<DiskAnswer>
     answer
 }
 
-/// A warning about what the view shows (a refused grid), over the bottom of `over` (the
-/// view) for as long as it holds, never a row that pushes the layout.
-pub fn view_warning(ctx: &egui::Context, over: egui::Rect, text: &str) {
-    egui::Area::new(egui::Id::unique("tracelab-view-warning"))
+/// A warning about what the view shows (a refused grid, supersampling past its caps), over
+/// the bottom of `over` (the view) for as long as it holds, never a row that pushes the
+/// layout. `what` keeps two warnings apart.
+pub fn view_warning(ctx: &egui::Context, over: egui::Rect, what: &str, text: &str) {
+    egui::Area::new(egui::Id::unique("tracelab-view-warning").with(what))
         .order(egui::Order::Foreground)
         .pivot(egui::Align2::CENTER_BOTTOM)
         .fixed_pos(over.center_bottom() - egui::vec2(0.0, 8.0))

@@ -442,8 +442,24 @@ impl TracelabApp {
             notifications::view_warning(
                 &ctx,
                 view.response.rect,
+                "grid",
                 &format!("View › Uniform grid: {e}. The view renders through the BVH instead."),
             );
+        }
+        // The renderer skips a supersampled pass past the caps (samples, filter weights) and
+        // keeps the one-ray image: say so over the view rather than only in the log.
+        if let Some(ss) = self.view.supersample {
+            let (w, h) = self.render_size;
+            if let Err(e) = tracelab_core::render::check_film(w, h, &ss.sampler, &ss.filter) {
+                notifications::view_warning(
+                    &ctx,
+                    view.response.rect,
+                    "supersampling",
+                    &format!(
+                        "View › Supersampling at {w}×{h}: {e}. The view shows one ray a pixel."
+                    ),
+                );
+            }
         }
         if self.disk_changed {
             match notifications::disk_changed(&ctx, view.response.rect) {
