@@ -6,6 +6,7 @@
 //! is an input, a header claiming a huge image, junk lines) each get a case.
 
 mod common;
+use common::tracelab;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -27,14 +28,6 @@ Group { numObjects 2
 ";
 
 const SIZE: u32 = 60;
-
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
-}
 
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()

@@ -4,16 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
-}
-
 mod common;
 use common::repo;
+use common::tracelab;
 
 fn temp_dir(name: &str) -> PathBuf {
     common::temp_dir("cli", name)

@@ -7,17 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
+use common::tracelab;
 
 fn temp_dir(name: &str) -> PathBuf {
     common::temp_dir("cli-text", name)
-}
-
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
 }
 
 fn stderr(o: &Output) -> String {

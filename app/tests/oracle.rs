@@ -6,19 +6,12 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use common::repo;
+use common::tracelab;
 use glam::{DMat3, DMat4, DVec3};
 use serde_json::Value;
-
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
-}
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("tracelab-oracle-{}-{name}", std::process::id()));

@@ -9,21 +9,14 @@
 //! when the files are missing.
 
 mod common;
+use common::tracelab;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use tracelab_core::render::Secondary;
 use tracelab_core::render::mistakes::{Mistake, Variant, render_variant, variant_rgb8};
 use tracelab_core::{CompiledScene, MeshCache, RenderSettings, View};
-
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
-}
 
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()

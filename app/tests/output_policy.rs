@@ -8,14 +8,7 @@ use std::process::{Command, Output};
 
 mod common;
 use common::repo;
-
-fn tracelab(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tracelab")
-}
+use common::tracelab;
 
 fn temp_dir(name: &str) -> PathBuf {
     common::temp_dir("output", name)

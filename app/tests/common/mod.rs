@@ -9,6 +9,15 @@ use std::path::{Path, PathBuf};
 mod data;
 pub use data::{course_dir, meshes_dir, perf_dir, semester_dir};
 
+/// Runs the built `tracelab` with `args` in `dir`, its output captured.
+pub fn tracelab(args: &[&str], dir: &Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run tracelab")
+}
+
 /// Copies the files of `from` (not its subfolders) into `to`, made first.
 pub fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).expect("create temp dir");
