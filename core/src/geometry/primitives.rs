@@ -109,6 +109,12 @@ pub fn intersect_triangle(
 /// `o + t d` crosses it, t not range-checked. The one scalar copy of the test: the mesh BVH's
 /// AVX leaf repeats these operations lane by lane, so every path gives the same t bit for bit.
 ///
+/// The inside test compares the undivided barycentrics with the determinant (0 ≤ u·det ≤ det,
+/// v·det ≥ 0, (u + v)·det ≤ det, signs taken from det), as Möller and Trumbore's paper and the
+/// course's programs do; only t, u and v of a hit are divided. A ray exactly on an edge then
+/// falls on the side those programs put it: dividing first rounds u + v past 1 for some of
+/// them (scene7_01's 3×3 uniform samples on the edge x + y = 0 at 12×12 differed on 8 pixels).
+///
 /// When the determinant overflows f32 (edges of ~1.8e19 and more seen by a unit ray) the
 /// test is done again in f64, which holds every product of f32 numbers: the triangle is
 /// still found where its edges are f32 numbers. The AVX leaf sends those lanes here too.
@@ -128,18 +134,22 @@ pub(crate) fn moller_trumbore(
     if !det.is_finite() {
         return moller_trumbore_f64(o, d, v0, e1, e2);
     }
-    let inv_det = 1.0 / det;
+    // Negating both sides of a comparison is exact: compare in det's sign.
+    let sign = if det < 0.0 { -1.0 } else { 1.0 };
+    let abs_det = det * sign;
     let s = o - v0;
-    let u = s.dot(p) * inv_det;
-    if !(0.0..=1.0).contains(&u) {
+    let u_det = s.dot(p);
+    if !(0.0..=abs_det).contains(&(u_det * sign)) {
         return None;
     }
     let q = s.cross(e1);
-    let v = d.dot(q) * inv_det;
-    if v < 0.0 || u + v > 1.0 {
+    let v_det = d.dot(q);
+    // A NaN v passes, as it always has (the AVX leaves repeat this).
+    if v_det * sign < 0.0 || (u_det + v_det) * sign > abs_det {
         return None;
     }
-    Some((e2.dot(q) * inv_det, u, v))
+    let inv_det = 1.0 / det;
+    Some((e2.dot(q) * inv_det, u_det * inv_det, v_det * inv_det))
 }
 
 /// `moller_trumbore` in f64, for the triangles whose determinant overflows f32. A t past
@@ -166,18 +176,25 @@ pub(crate) fn moller_trumbore_f64(
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    let inv_det = 1.0 / det;
+    // The f32 test's comparisons, undivided, in det's sign.
+    let sign = if det < 0.0 { -1.0 } else { 1.0 };
+    let abs_det = det * sign;
     let s = o - v0;
-    let u = s.dot(p) * inv_det;
-    if !(0.0..=1.0).contains(&u) {
+    let u_det = s.dot(p);
+    if !(0.0..=abs_det).contains(&(u_det * sign)) {
         return None;
     }
     let q = s.cross(e1);
-    let v = d.dot(q) * inv_det;
-    if v < 0.0 || u + v > 1.0 {
+    let v_det = d.dot(q);
+    if v_det * sign < 0.0 || (u_det + v_det) * sign > abs_det {
         return None;
     }
-    Some(((e2.dot(q) * inv_det) as f32, u as f32, v as f32))
+    let inv_det = 1.0 / det;
+    Some((
+        (e2.dot(q) * inv_det) as f32,
+        (u_det * inv_det) as f32,
+        (v_det * inv_det) as f32,
+    ))
 }
 
 /// The face normal (b − a) × (c − a), normalised: counter-clockwise vertices face the viewer.
@@ -386,6 +403,35 @@ mod tests {
             Vec3::new(0.0, 3e38, 0.0),
         );
         assert!(intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).is_none());
+    }
+
+    /// scene7_01's triangle and two of output7_01d_low_res's uniform samples that lie exactly
+    /// on its edge x + y = 0 (x = −y to the bit): inside, as the course's programs find them
+    /// (their undivided comparison u·det + v·det ≤ det). The control: dividing by det first,
+    /// as this test did before, rounds u + v past 1 and leaves them out.
+    #[test]
+    fn a_ray_exactly_on_an_edge_is_inside_as_the_course_programs_find_it() {
+        let (a, b, c) = (
+            Vec3::new(-2.0, -2.0, 0.0),
+            Vec3::new(1.8, -1.8, 0.0),
+            Vec3::new(-1.95, 1.95, 0.0),
+        );
+        for bits in [0x3f97_1c72_u32, 0x3ef8_e38c] {
+            let x = f32::from_bits(bits);
+            let r = Ray::new(Vec3::new(x, -x, 10.0), Vec3::NEG_Z);
+            let (t, u, v) = intersect_triangle(&r, a, b, c, 0.0, f32::INFINITY).expect("inside");
+            assert!(
+                (t - 10.0).abs() < 1e-5 && (u + v - 1.0).abs() < 1e-6,
+                "{t} {u} {v}"
+            );
+            // Control: the divided form rejects this very ray.
+            let (e1, e2) = (b - a, c - a);
+            let p = r.direction.cross(e2);
+            let inv = 1.0 / e1.dot(p);
+            let s = r.origin - a;
+            let (u, v) = (s.dot(p) * inv, r.direction.dot(s.cross(e1)) * inv);
+            assert!(u + v > 1.0, "not a tie the divided test loses: {x}");
+        }
     }
 
     #[test]

@@ -163,12 +163,16 @@ pub(super) fn leaf8<L: LeafRay>(
     let dot = |ax, ay, az, bx, by, bz| add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
     let (px, py, pz) = cross(dx, dy, dz, e2x, e2y, e2z);
     let det = dot(e1x, e1y, e1z, px, py, pz);
-    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
     let sx = sub(_mm256_set1_ps(o.x), v0x);
     let sy = sub(_mm256_set1_ps(o.y), v0y);
     let sz = sub(_mm256_set1_ps(o.z), v0z);
-    let u = mul(dot(sx, sy, sz, px, py, pz), inv_det);
-    let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+    // The scalar test's undivided comparisons in det's sign: flipping the sign bit is its
+    // exact negation.
+    let sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0));
+    let abs_det = _mm256_xor_ps(det, sign);
+    let u_det = dot(sx, sy, sz, px, py, pz);
+    let u = _mm256_xor_ps(u_det, sign);
+    let zero = _mm256_setzero_ps();
     let lanes = (1u32 << count) - 1;
     // A determinant that overflowed (det − det is NaN): the scalar test redoes those in
     // f64, so they are taken from it below (rare: edges of ~1.8e19 and more).
@@ -179,7 +183,7 @@ pub(super) fn leaf8<L: LeafRay>(
         _mm256_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
         _mm256_and_ps(
             _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
-            _mm256_cmp_ps::<_CMP_LE_OQ>(u, one),
+            _mm256_cmp_ps::<_CMP_LE_OQ>(u, abs_det),
         ),
     );
     // Most leaves a ray enters hold no triangle it crosses: stop before the second half.
@@ -187,12 +191,14 @@ pub(super) fn leaf8<L: LeafRay>(
         return None;
     }
     let (qx, qy, qz) = cross(sx, sy, sz, e1x, e1y, e1z);
-    let v = mul(dot(dx, dy, dz, qx, qy, qz), inv_det);
+    let v_det = dot(dx, dy, dz, qx, qy, qz);
+    let v = _mm256_xor_ps(v_det, sign);
+    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
     let t = mul(dot(e2x, e2y, e2z, qx, qy, qz), inv_det);
-    // The scalar test rejects when v < 0 or u + v > 1 (so a NaN v passes here, as there).
+    // The scalar test rejects when v < 0 or u + v > det (so a NaN v passes here, as there).
     let reject = _mm256_or_ps(
         _mm256_cmp_ps::<_CMP_LT_OQ>(v, zero),
-        _mm256_cmp_ps::<_CMP_GT_OQ>(add(u, v), one),
+        _mm256_cmp_ps::<_CMP_GT_OQ>(add(u, v), abs_det),
     );
     let in_range = _mm256_and_ps(
         _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(t_min)),

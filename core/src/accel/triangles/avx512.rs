@@ -51,26 +51,28 @@ pub(super) fn leaf8<L: avx::LeafRay>(
     let dot = |ax, ay, az, bx, by, bz| add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
     let (px, py, pz) = cross(dx, dy, dz, e2x, e2y, e2z);
     let det = dot(e1x, e1y, e1z, px, py, pz);
-    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
     let sx = sub(_mm256_set1_ps(o.x), v0x);
     let sy = sub(_mm256_set1_ps(o.y), v0y);
     let sz = sub(_mm256_set1_ps(o.z), v0z);
-    let u = mul(dot(sx, sy, sz, px, py, pz), inv_det);
-    let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+    let sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0));
+    let abs_det = _mm256_xor_ps(det, sign);
+    let u = _mm256_xor_ps(dot(sx, sy, sz, px, py, pz), sign);
+    let zero = _mm256_setzero_ps();
     let lanes = ((1u32 << count) - 1) as u8;
     let overflow = sub(det, det);
     let slow = _mm256_cmp_ps_mask::<_CMP_UNORD_Q>(overflow, overflow) & lanes;
     let ok = _mm256_mask_cmp_ps_mask::<_CMP_NEQ_OQ>(lanes & !slow, det, zero);
     let ok = _mm256_mask_cmp_ps_mask::<_CMP_GE_OQ>(ok, u, zero);
-    let ok = _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(ok, u, one);
+    let ok = _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(ok, u, abs_det);
     if ok == 0 && slow == 0 {
         return None;
     }
     let (qx, qy, qz) = cross(sx, sy, sz, e1x, e1y, e1z);
-    let v = mul(dot(dx, dy, dz, qx, qy, qz), inv_det);
+    let v = _mm256_xor_ps(dot(dx, dy, dz, qx, qy, qz), sign);
+    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
     let t = mul(dot(e2x, e2y, e2z, qx, qy, qz), inv_det);
     let reject = _mm256_cmp_ps_mask::<_CMP_LT_OQ>(v, zero)
-        | _mm256_cmp_ps_mask::<_CMP_GT_OQ>(add(u, v), one);
+        | _mm256_cmp_ps_mask::<_CMP_GT_OQ>(add(u, v), abs_det);
     let in_range = _mm256_mask_cmp_ps_mask::<_CMP_GT_OQ>(ok & !reject, t, _mm256_set1_ps(t_min));
     let mut mask =
         _mm256_mask_cmp_ps_mask::<_CMP_LT_OQ>(in_range, t, _mm256_set1_ps(t_best)) as u32;

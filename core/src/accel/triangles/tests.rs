@@ -810,3 +810,45 @@ fn any_hit_agrees_on_shared_meshes() {
         assert!(hits > 0 && hits < compared, "{name}");
     }
 }
+
+/// Rays exactly on edges (output7_01d_low_res's 3×3 uniform samples at 12×12 on scene7_01's
+/// triangle, whose edge x + y = 0 they meet to the bit, beside a mirrored neighbour sharing
+/// that edge): every path (AVX-512, AVX, portable, brute force) decides each tie the same,
+/// from above and from below (det of either sign), and a ray turned round hits the same.
+#[test]
+fn rays_exactly_on_edges_agree_on_every_path_and_both_sides() {
+    let pos = vec![
+        Vec3::new(-2.0, -2.0, 0.0),
+        Vec3::new(1.8, -1.8, 0.0),
+        Vec3::new(-1.95, 1.95, 0.0),
+        Vec3::new(2.0, 2.0, 0.0),
+    ];
+    let tris = vec![[0, 1, 2], [3, 2, 1]];
+    let bvh = build_checked(&pos, &tris);
+    let (n, k) = (12, 3);
+    let mut above = Vec::new();
+    let mut below = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            for s in 0..k * k {
+                let sx = ((s % k) as f32 + 0.5) / k as f32;
+                let sy = ((s / k) as f32 + 0.5) / k as f32;
+                let x = ((i as f32 + sx) / n as f32 - 0.5) * 5.0;
+                let y = ((j as f32 + sy) / n as f32 - 0.5) * 5.0;
+                above.push(Ray::new(Vec3::new(x, y, 10.0), Vec3::NEG_Z));
+                below.push(Ray::new(Vec3::new(x, y, -10.0), Vec3::Z));
+            }
+        }
+    }
+    assert_agrees(&pos, &tris, &bvh, &above);
+    assert_agrees(&pos, &tris, &bvh, &below);
+    let on_edge = above
+        .iter()
+        .filter(|r| r.origin.x == -r.origin.y && r.origin.x.abs() < 1.8)
+        .count();
+    assert!(on_edge >= 8, "{on_edge} rays exactly on the edge");
+    for (a, b) in above.iter().zip(&below) {
+        let hit = |r: &Ray| bvh.intersect(r, 0.0, f32::INFINITY).map(|h| h.triangle);
+        assert_eq!(hit(a), hit(b), "{:?}", a.origin);
+    }
+}
