@@ -4,6 +4,9 @@
 //! with standard error redirected (scripts, tests, a grading server) nothing is printed.
 
 use std::io::IsTerminal;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -70,6 +73,40 @@ impl Progress {
     pub fn finish(self) {
         if self.shown {
             self.bar.finish();
+        }
+    }
+}
+
+/// A bar redrawn from another thread every 100 ms while work that cannot report its own
+/// progress runs (a render, a film), reading `done` (steps of `len`). Nothing is spawned when
+/// standard error is no terminal.
+pub(super) struct Watcher {
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Watcher {
+    pub fn on_stderr(template: &str, len: u64, done: impl Fn() -> u64 + Send + 'static) -> Self {
+        let mut bar = Progress::on_stderr(template, len);
+        let stop = Arc::new(AtomicBool::new(false));
+        let thread = bar.on_terminal().then(|| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    std::thread::sleep(Duration::from_millis(100));
+                    bar.set(done().min(len));
+                }
+                bar.finish();
+            })
+        });
+        Watcher { stop, thread }
+    }
+
+    /// The work is done: the bar (if shown) is finished before this returns.
+    pub fn finish(mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
         }
     }
 }

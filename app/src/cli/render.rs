@@ -4,8 +4,6 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
 
 use clap::ValueEnum;
 use tracelab_core::render::{
@@ -13,8 +11,8 @@ use tracelab_core::render::{
 };
 use tracelab_core::{CompiledScene, NormalTransform, ObjectRays, RenderSettings, View};
 
-use super::progress::Progress;
-use super::supersample::{Supersample, film_error, film_for, write_pictures};
+use super::progress::Watcher;
+use super::supersample::{Supersample, film_for, filtered_frame, write_pictures};
 use super::values::parse_f32;
 use crate::exit::{check_size, usage};
 use crate::io::{OutputError, OutputPlan, load_scene_and_meshes};
@@ -353,7 +351,7 @@ pub fn run_render(job: &RenderJob) -> anyhow::Result<()> {
         if let Some(p) = &job.output {
             let frame = match &film {
                 Some(f) if job.supersample.filters_the_output() => {
-                    f.frame(&resolved.filter).map_err(film_error)?
+                    filtered_frame(f, &resolved.filter)?
                 }
                 _ => render_with_progress(&compiled, &settings)?,
             };
@@ -416,9 +414,7 @@ pub(super) fn frame_for(
         let resolved = job
             .supersample
             .resolve(settings.width, settings.height, &[], None)?;
-        return film_for(compiled, settings, &resolved)?
-            .frame(&resolved.filter)
-            .map_err(film_error);
+        return filtered_frame(&film_for(compiled, settings, &resolved)?, &resolved.filter);
     }
     if job.visualize_grid {
         return Ok(tracelab_core::render::visualize_grid(
@@ -466,24 +462,13 @@ pub(super) fn render_with_progress(
         SharedFrame::try_sized(settings.width, settings.height)
             .map_err(|_| out_of_memory(settings.width, settings.height))?,
     );
-    let done = Arc::new(AtomicBool::new(false));
-    let mut bar = Progress::on_stderr(RENDER_PROGRESS, 1000);
-    let watcher = bar.on_terminal().then(|| {
-        let (target, done) = (target.clone(), done.clone());
-        std::thread::spawn(move || {
-            while !done.load(Ordering::Relaxed) {
-                std::thread::sleep(Duration::from_millis(100));
-                bar.set((target.progress() * 1000.0) as u64);
-            }
-            bar.finish();
-        })
+    let watched = target.clone();
+    let bar = Watcher::on_stderr(RENDER_PROGRESS, 1000, move || {
+        (watched.progress() * 1000.0) as u64
     });
     let plan = RenderPlan::FULL;
     let Ok(()) = render(scene, settings, plan, &target, &Uncancellable, |_| {});
-    done.store(true, Ordering::Relaxed);
-    if let Some(w) = watcher {
-        let _ = w.join();
-    }
+    bar.finish();
     Ok(std::mem::replace(
         &mut *target.lock(),
         tracelab_core::Frame::new(0, 0),
