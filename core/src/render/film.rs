@@ -311,27 +311,6 @@ impl Film {
         Ok(Ok(frame))
     }
 
-    /// Writes the filtered colours over `frame`'s (same size), keeping its normals, depths
-    /// and hits: those of the centre rays, which picking and the other views use.
-    pub fn filter_into(&self, filter: &Filter, frame: &mut Frame) -> Result<(), FilmError> {
-        check_film(self.width, self.height, &self.sampler, filter)?;
-        if (frame.width, frame.height) != (self.width, self.height) {
-            return Ok(());
-        }
-        let w = self.width as usize;
-        frame
-            .samples
-            .par_chunks_mut(w)
-            .enumerate()
-            .for_each(|(row, out)| {
-                let j = self.height - 1 - row as u32;
-                for (i, s) in out.iter_mut().enumerate() {
-                    s.color = bytes(self.filtered(filter, i as u32, j));
-                }
-            });
-        Ok(())
-    }
-
     /// `-render_samples`: each pixel a `zoom` × `zoom` square, grey (0.2) and black as a
     /// checkerboard, with every sample a dot of its colour at ⌊(i + x)·zoom⌋, ⌊(j + y)·zoom⌋.
     pub fn samples_picture(&self, zoom: u32) -> Result<Picture, FilmError> {

@@ -579,10 +579,22 @@ fn render_scales<C: Cancel>(
         pass += 1;
     }
     if let Some(ss) = settings.supersample.filter(|_| supersampled) {
-        // Traced with the frame unlocked; filtered into it under the lock.
+        // Traced and filtered with the frame unlocked, and cancellably: a wide filter over
+        // many samples takes seconds, which neither the editor's paint (it locks the frame)
+        // nor an edit (it cancels) should wait for. Only the colours are copied in under the
+        // lock; the centre rays' normals, depths and hits stay for picking and other views.
         if let Some(film) = super::film::supersample_film(scene, settings, ss, cancel)? {
-            match film.filter_into(&ss.filter, &mut target.lock()) {
-                Ok(()) => target.bump(),
+            match film.frame_until(&ss.filter, cancel)? {
+                Ok(filtered) => {
+                    let mut frame = target.lock();
+                    if (frame.width, frame.height) == (filtered.width, filtered.height) {
+                        for (s, f) in frame.samples.iter_mut().zip(&filtered.samples) {
+                            s.color = f.color;
+                        }
+                    }
+                    drop(frame);
+                    target.bump();
+                }
                 Err(e) => log::warn!("supersampling skipped: {e}"),
             }
         }
