@@ -291,7 +291,7 @@ impl TriangleBvh {
             t_min,
             t_max,
             |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+                avx512::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
             |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
         )
@@ -362,7 +362,7 @@ impl TriangleBvh {
             t_min,
             t_max,
             |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+                avx512::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
             |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
         )
