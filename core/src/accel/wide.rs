@@ -1,7 +1,7 @@
 //! 8-wide BVH nodes, collapsed from the binary SAH tree: each node holds up to eight child
 //! boxes stored axis by axis, so one ray meets all eight in a handful of vector instructions.
 //! `collapse` builds them with f32 bounds (`Node8`); the mesh's tree keeps them quantised
-//! (`QNode8`, 128 bytes instead of 224), decoded to f32 planes before the slab test.
+//! (`QNode8`, 160 bytes instead of 224), decoded to f32 planes before the slab test.
 
 use std::mem::MaybeUninit;
 
@@ -87,12 +87,16 @@ impl Node8 {
     }
 }
 
-/// The largest grid exponent: 255 * 2^120 < f32::MAX, so q * step never overflows and is
-/// exact for every q (an 8-bit integer times a power of two, subnormal or not).
-const MAX_EXP: i32 = 120;
+/// A grid index: 16 bits (8 bits cost the dragon's single rays ~8% in looser boxes alone).
+pub type Q = u16;
+const Q_MAX: f32 = Q::MAX as f32;
 
-/// A `Node8` in 128 bytes (two cache lines, 64-byte aligned; `Node8` spans four): per axis a
-/// grid of origin + q * step with step a power of two, and each child's bounds as 8-bit grid
+/// The largest grid exponent: 65535 * 2^112 < f32::MAX, so q * step never overflows and is
+/// exact for every q (a 16-bit integer times a power of two, subnormal or not).
+const MAX_EXP: i32 = 112;
+
+/// A `Node8` in 160 bytes (224 as f32): per axis a
+/// grid of origin + q * step with step a power of two, and each child's bounds as 16-bit grid
 /// indices, lo rounded down and hi up, so every decoded box contains the child's box.
 ///
 /// Decoding is `origin + q * step` in f32: the product is exact, so the one rounding is the
@@ -100,23 +104,23 @@ const MAX_EXP: i32 = 120;
 /// evaluating that very expression, so the containment holds for the decoded floats
 /// themselves, and the slab tests run on them as on any f32 box (`SLAB_WIDEN`'s bound is
 /// unchanged). An axis whose bounds no grid covers (non-finite, or spanning more than
-/// 255 * 2^120) has a NaN origin: every plane decodes to NaN, which the slab tests' max/min
+/// 65535 * 2^112) has a NaN origin: every plane decodes to NaN, which the slab tests' max/min
 /// drop (the NaN rule they already rely on), so that axis culls nothing in this node.
 #[derive(Clone, Debug)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 pub struct QNode8 {
     pub origin: [f32; 3],
     pub step: [f32; 3],
     /// Indexed [axis][slot].
-    pub lo: [[u8; WIDTH]; 3],
-    pub hi: [[u8; WIDTH]; 3],
+    pub lo: [[Q; WIDTH]; 3],
+    pub hi: [[Q; WIDTH]; 3],
     pub child: [Child; WIDTH],
     /// Bit i set when slot i holds a child: the slab tests' masks are cut to it, since a
     /// quantised box cannot be empty for every ray as +inf..-inf is.
     pub used: u8,
 }
 
-const _: () = assert!(std::mem::size_of::<QNode8>() == 128);
+const _: () = assert!(std::mem::size_of::<QNode8>() == 160);
 
 /// Bitwise, so two trees with the same NaN origin compare equal.
 impl PartialEq for QNode8 {
@@ -131,13 +135,13 @@ impl PartialEq for QNode8 {
 impl QNode8 {
     /// Grid index `q` on axis `a` as a plane: the value every slab test computes.
     #[inline(always)]
-    pub fn decode(&self, a: usize, q: u8) -> f32 {
+    pub fn decode(&self, a: usize, q: Q) -> f32 {
         self.origin[a] + f32::from(q) * self.step[a]
     }
 
     /// Slot i's decoded box, a NaN axis as -inf..inf (what the slab tests make of it).
     pub fn slot_bounds(&self, i: usize) -> Aabb {
-        let f = |q: &[[u8; WIDTH]; 3], none: f32| {
+        let f = |q: &[[Q; WIDTH]; 3], none: f32| {
             Vec3::from_array([0, 1, 2].map(|a| {
                 let v = self.decode(a, q[a][i]);
                 if v.is_nan() { none } else { v }
@@ -153,7 +157,7 @@ impl QNode8 {
     /// Axis `a`'s (entry, exit) index rows for a ray whose direction's sign on that axis is
     /// negative when `toward_neg`: such a ray enters through the max plane.
     #[inline(always)]
-    pub fn entry_exit(&self, a: usize, toward_neg: bool) -> (&[u8; WIDTH], &[u8; WIDTH]) {
+    pub fn entry_exit(&self, a: usize, toward_neg: bool) -> (&[Q; WIDTH], &[Q; WIDTH]) {
         if toward_neg {
             (&self.hi[a], &self.lo[a])
         } else {
@@ -163,7 +167,7 @@ impl QNode8 {
 
     /// A row decoded in two four-lane halves (the SSE slab test's form).
     #[inline(always)]
-    pub fn decode_row(&self, a: usize, q: &[u8; WIDTH]) -> [Vec4; 2] {
+    pub fn decode_row(&self, a: usize, q: &[Q; WIDTH]) -> [Vec4; 2] {
         let half = |h: usize| {
             let v = Vec4::from_array([0, 1, 2, 3].map(|l| f32::from(q[4 * h + l])));
             Vec4::splat(self.origin[a]) + v * Vec4::splat(self.step[a])
@@ -176,7 +180,7 @@ impl QNode8 {
         let mut q = QNode8 {
             origin: [0.0; 3],
             step: [1.0; 3],
-            lo: [[u8::MAX; WIDTH]; 3],
+            lo: [[Q::MAX; WIDTH]; 3],
             hi: [[0; WIDTH]; 3],
             child: n.child,
             used: 0,
@@ -198,22 +202,23 @@ impl QNode8 {
                 continue;
             };
             (q.origin[a], q.step[a]) = (origin, step);
-            let dec = |k: u8| origin + f32::from(k) * step;
-            let guess =
-                |v: f32| ((f64::from(v) - f64::from(origin)) / f64::from(step)).clamp(0.0, 255.0);
+            let dec = |k: Q| origin + f32::from(k) * step;
+            let guess = |v: f32| {
+                ((f64::from(v) - f64::from(origin)) / f64::from(step)).clamp(0.0, f64::from(Q_MAX))
+            };
             for &i in &used {
                 // The f64 guess is within one of the answer; the loops settle it on the
                 // decoded f32 values: the largest index at or below lo, the smallest at or
-                // above hi (index 0 decodes to origin <= lo, 255 to at least hi_max).
-                let mut l = guess(lo(i)).floor() as u8;
+                // above hi (index 0 decodes to origin <= lo, Q::MAX to at least hi_max).
+                let mut l = guess(lo(i)).floor() as Q;
                 while l > 0 && dec(l) > lo(i) {
                     l -= 1;
                 }
-                while l < u8::MAX && dec(l + 1) <= lo(i) {
+                while l < Q::MAX && dec(l + 1) <= lo(i) {
                     l += 1;
                 }
-                let mut h = guess(hi(i)).ceil() as u8;
-                while h < u8::MAX && dec(h) < hi(i) {
+                let mut h = guess(hi(i)).ceil() as Q;
+                while h < Q::MAX && dec(h) < hi(i) {
                     h += 1;
                 }
                 while h > 0 && dec(h - 1) >= hi(i) {
@@ -226,7 +231,7 @@ impl QNode8 {
     }
 }
 
-/// (origin, step) of the finest grid whose 256 planes from `lo_min` reach `hi_max`, decoded
+/// (origin, step) of the finest grid whose 65536 planes from `lo_min` reach `hi_max`, decoded
 /// as `QNode8::decode` does; None when no power of two up to 2^MAX_EXP does (or a bound is
 /// not finite).
 fn grid(lo_min: f32, hi_max: f32) -> Option<(f32, f32)> {
@@ -235,7 +240,7 @@ fn grid(lo_min: f32, hi_max: f32) -> Option<(f32, f32)> {
     }
     let span = f64::from(hi_max) - f64::from(lo_min);
     let mut e = if span > 0.0 {
-        (span / 255.0).log2().ceil() as i32
+        (span / f64::from(Q_MAX)).log2().ceil() as i32
     } else {
         -149
     };
@@ -244,7 +249,7 @@ fn grid(lo_min: f32, hi_max: f32) -> Option<(f32, f32)> {
     while e <= MAX_EXP {
         // 2^e as f32, exact for -149..=127 (subnormal below -126).
         let step = 2f64.powi(e) as f32;
-        if lo_min + 255.0 * step >= hi_max {
+        if lo_min + Q_MAX * step >= hi_max {
             return Some((lo_min, step));
         }
         e += 1;
@@ -422,14 +427,14 @@ mod tests {
             }
             let hi_max = boxes.iter().map(|b| b.max[a]).fold(f32::MIN, f32::max);
             if q.step[a] > f32::from_bits(1) {
-                let coarse = q.origin[a] + 255.0 * (q.step[a] * 0.5);
+                let coarse = q.origin[a] + Q_MAX * (q.step[a] * 0.5);
                 assert!(coarse < hi_max, "axis {a}: a finer grid reaches {hi_max}");
             }
             for (i, b) in boxes.iter().enumerate() {
                 let (l, h) = (q.lo[a][i], q.hi[a][i]);
                 assert!(q.decode(a, l) <= b.min[a] && q.decode(a, h) >= b.max[a]);
                 assert!(
-                    l == 255 || q.decode(a, l + 1) > b.min[a],
+                    l == Q::MAX || q.decode(a, l + 1) > b.min[a],
                     "slot {i} axis {a} lo"
                 );
                 assert!(
@@ -471,7 +476,7 @@ mod tests {
         assert_tight(&[Aabb::new(Vec3::splat(3.5), Vec3::splat(3.5))]);
     }
 
-    /// Bounds no grid of 2^120 steps spans, or infinite ones: that axis decodes to NaN, shown
+    /// Bounds no grid of 2^112 steps spans, or infinite ones: that axis decodes to NaN, shown
     /// as unbounded, and the other axes are still quantised.
     #[test]
     fn unquantisable_axes_decode_to_nan() {
@@ -487,7 +492,7 @@ mod tests {
         let s = q.slot_bounds(0);
         assert_eq!((s.min.x, s.max.x), (f32::NEG_INFINITY, f32::INFINITY));
         assert!(s.min.y <= 0.0 && s.max.y >= 1.0 && s.max.y < 1.1);
-        // Within 255 * 2^120 it is quantised.
+        // Within 65535 * 2^112 it is quantised.
         let q = assert_tight(&[Aabb::new(Vec3::splat(-1e38), Vec3::splat(1.5e38))]);
         assert!(!q.origin[0].is_nan());
     }

@@ -1,13 +1,13 @@
 //! The AVX kernels: a ray against a node's eight boxes, and against a leaf's up to eight
 //! triangles, plus the tail every 8-box test shares (the packet's tests in `packet` too).
-//! Every `unsafe` they need is in `load8` and `store8`.
+//! Every `unsafe` they need is in `load8`, `store8` and `load_q`.
 
 use std::arch::x86_64::*;
 
 use glam::Vec3A;
 
 use super::{SLAB_WIDEN, TriangleBvh};
-use crate::accel::wide::{QNode8, WIDTH};
+use crate::accel::wide::{Q, QNode8, WIDTH};
 
 /// Eight floats as one register.
 #[target_feature(enable = "avx")]
@@ -31,15 +31,26 @@ pub(super) fn store8(v: &mut [f32; WIDTH], x: __m256) {
     }
 }
 
+/// One axis row of a node's grid indices as one register.
+#[target_feature(enable = "avx")]
+#[inline]
+pub(super) fn load_q(row: &[Q; WIDTH]) -> __m128i {
+    #[allow(unsafe_code)]
+    // SAFETY: `row` is 8 contiguous u16, the 16 bytes an unaligned 128-bit load reads.
+    unsafe {
+        _mm_loadu_si128(row.as_ptr().cast::<__m128i>())
+    }
+}
+
 /// One axis row of a node's quantised bounds (`QNode8::lo[a]` or `hi[a]`) decoded, slot i
 /// in lane i: origin + q * step, `QNode8::decode`'s value bit for bit (an exact product and
 /// one rounding). AVX has no 256-bit integer widening, so two SSE4.1 halves.
 #[target_feature(enable = "avx")]
 #[inline]
-pub(super) fn decode_row(n: &QNode8, a: usize, row: &[u8; WIDTH]) -> __m256 {
-    let q = _mm_cvtsi64_si128(i64::from_le_bytes(*row));
-    let lo = _mm_cvtepu8_epi32(q);
-    let hi = _mm_cvtepu8_epi32(_mm_srli_si128::<4>(q));
+pub(super) fn decode_row(n: &QNode8, a: usize, row: &[Q; WIDTH]) -> __m256 {
+    let q = load_q(row);
+    let lo = _mm_cvtepu16_epi32(q);
+    let hi = _mm_cvtepu16_epi32(_mm_srli_si128::<8>(q));
     let q = _mm256_cvtepi32_ps(_mm256_set_m128i(hi, lo));
     _mm256_add_ps(
         _mm256_set1_ps(n.origin[a]),
@@ -91,7 +102,7 @@ pub(super) fn slab8(
     let slab = |a: usize| {
         let (entry, exit) = n.entry_exit(a, toward_neg[a]);
         let (o, inv) = (_mm256_set1_ps(o[a]), _mm256_set1_ps(inv[a]));
-        let dist = |row: &[u8; WIDTH]| _mm256_mul_ps(_mm256_sub_ps(decode_row(n, a, row), o), inv);
+        let dist = |row: &[Q; WIDTH]| _mm256_mul_ps(_mm256_sub_ps(decode_row(n, a, row), o), inv);
         (dist(entry), dist(exit))
     };
     let (nx, fx) = slab(0);

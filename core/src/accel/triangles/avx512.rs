@@ -1,6 +1,7 @@
 //! The AVX-512 kernel: `avx::leaf8` with the tests' results in mask registers, for the
-//! single-ray traversal compiled for AVX-512 (F and VL). It needs no `unsafe` of its own
-//! (its loads and stores are `avx::load8` and `avx::store8`).
+//! single-ray traversal compiled for AVX-512 (F and VL), and its 8-box test decoding each
+//! quantised row with one FMA (`slab8`). It needs no `unsafe` of its own
+//! (its loads and stores are `avx::load8`, `avx::load_q` and `avx::store8`).
 //!
 //! Tried and dropped (`docs/perf.md`): a packet's rays two at a time against a leaf in one
 //! 16-lane register: bit-exact, but no faster than `leaf8` one ray at a time on Zen 5.
@@ -11,7 +12,7 @@ use glam::Vec3A;
 
 use super::TriangleBvh;
 use super::avx;
-use crate::accel::wide::{QNode8, WIDTH};
+use crate::accel::wide::{Q, QNode8, WIDTH};
 
 /// `avx::slab8` with each row decoded by one fused multiply-add: q * step is exact (a
 /// power of two), so fma(q, step, origin) rounds once, as origin + q * step does: the same
@@ -31,10 +32,8 @@ pub(super) fn slab8(
         let (entry, exit) = n.entry_exit(a, toward_neg[a]);
         let (o, inv) = (_mm256_set1_ps(o[a]), _mm256_set1_ps(inv[a]));
         let (origin, step) = (_mm256_set1_ps(n.origin[a]), _mm256_set1_ps(n.step[a]));
-        let dist = |row: &[u8; WIDTH]| {
-            let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_cvtsi64_si128(
-                i64::from_le_bytes(*row),
-            )));
+        let dist = |row: &[Q; WIDTH]| {
+            let q = _mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(avx::load_q(row)));
             _mm256_mul_ps(_mm256_sub_ps(_mm256_fmadd_ps(q, step, origin), o), inv)
         };
         (dist(entry), dist(exit))
