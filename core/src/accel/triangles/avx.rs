@@ -1,13 +1,13 @@
 //! The AVX kernels: a ray against a node's eight boxes, and against a leaf's up to eight
 //! triangles, plus the tail every 8-box test shares (the packet's tests in `packet` too).
-//! Every `unsafe` they need is in `load8`, `store8` and `load_q`.
+//! Every `unsafe` they need is in `load8`, `store8` and `load_row`.
 
 use std::arch::x86_64::*;
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 
 use super::{SLAB_WIDEN, TriangleBvh};
-use crate::accel::wide::{Q, QNode8, WIDTH};
+use crate::accel::wide::{Node8, WIDTH};
 
 /// Eight floats as one register.
 #[target_feature(enable = "avx")]
@@ -31,31 +31,18 @@ pub(super) fn store8(v: &mut [f32; WIDTH], x: __m256) {
     }
 }
 
-/// One axis row of a node's grid indices as one register.
-#[target_feature(enable = "avx")]
-#[inline]
-pub(super) fn load_q(row: &[Q; WIDTH]) -> __m128i {
-    #[allow(unsafe_code)]
-    // SAFETY: `row` is 8 contiguous u16, the 16 bytes an unaligned 128-bit load reads.
-    unsafe {
-        _mm_loadu_si128(row.as_ptr().cast::<__m128i>())
-    }
-}
+const _: () = assert!(std::mem::size_of::<[Vec4; 2]>() == WIDTH * 4);
 
-/// One axis row of a node's quantised bounds (`QNode8::lo[a]` or `hi[a]`) decoded, slot i
-/// in lane i: origin + q * step, `QNode8::decode`'s value bit for bit (an exact product and
-/// one rounding). AVX has no 256-bit integer widening, so two SSE4.1 halves.
+/// One axis row of a node's boxes (`Node8::lo[a]` or `hi[a]`), slot i in lane i.
 #[target_feature(enable = "avx")]
 #[inline]
-pub(super) fn decode_row(n: &QNode8, a: usize, row: &[Q; WIDTH]) -> __m256 {
-    let q = load_q(row);
-    let lo = _mm_cvtepu16_epi32(q);
-    let hi = _mm_cvtepu16_epi32(_mm_srli_si128::<8>(q));
-    let q = _mm256_cvtepi32_ps(_mm256_set_m128i(hi, lo));
-    _mm256_add_ps(
-        _mm256_set1_ps(n.origin[a]),
-        _mm256_mul_ps(q, _mm256_set1_ps(n.step[a])),
-    )
+pub(super) fn load_row(row: &[Vec4; 2]) -> __m256 {
+    #[allow(unsafe_code)]
+    // SAFETY: `[Vec4; 2]` is 8 contiguous f32 (`Vec4` is four f32 with no padding, the
+    // assertion above); an unaligned 256-bit load reads exactly them.
+    unsafe {
+        _mm256_loadu_ps(row.as_ptr().cast::<f32>())
+    }
 }
 
 /// The end of every 8-box slab test, from the per-axis entry and exit distances of the
@@ -91,7 +78,7 @@ pub(super) fn slab_tail(
 #[target_feature(enable = "avx")]
 #[inline]
 pub(super) fn slab8(
-    n: &QNode8,
+    n: &Node8,
     o: Vec3A,
     inv: Vec3A,
     toward_neg: [bool; 3],
@@ -102,7 +89,7 @@ pub(super) fn slab8(
     let slab = |a: usize| {
         let (entry, exit) = n.entry_exit(a, toward_neg[a]);
         let (o, inv) = (_mm256_set1_ps(o[a]), _mm256_set1_ps(inv[a]));
-        let dist = |row: &[Q; WIDTH]| _mm256_mul_ps(_mm256_sub_ps(decode_row(n, a, row), o), inv);
+        let dist = |row: &[Vec4; 2]| _mm256_mul_ps(_mm256_sub_ps(load_row(row), o), inv);
         (dist(entry), dist(exit))
     };
     let (nx, fx) = slab(0);
@@ -111,7 +98,7 @@ pub(super) fn slab8(
     let (t_min, t_max) = (_mm256_set1_ps(t_min), _mm256_set1_ps(t_max));
     let (near, mask) = slab_tail([nx, ny, nz], [fx, fy, fz], t_min, t_max);
     store8(t_enter, near);
-    mask & u32::from(n.used)
+    mask
 }
 
 /// A ray as the leaf test reads it: the single-ray traversal's `SlabRay`, or a packet's

@@ -1,51 +1,15 @@
 //! The AVX-512 kernel: `avx::leaf8` with the tests' results in mask registers, for the
-//! single-ray traversal compiled for AVX-512 (F and VL), and its 8-box test decoding each
-//! quantised row with one FMA (`slab8`). It needs no `unsafe` of its own
-//! (its loads and stores are `avx::load8`, `avx::load_q` and `avx::store8`).
+//! single-ray traversal compiled for AVX-512 (F and VL). It needs no `unsafe` of its own
+//! (its loads and stores are `avx::load8` and `avx::store8`).
 //!
 //! Tried and dropped (`docs/perf.md`): a packet's rays two at a time against a leaf in one
 //! 16-lane register: bit-exact, but no faster than `leaf8` one ray at a time on Zen 5.
 
 use std::arch::x86_64::*;
 
-use glam::Vec3A;
-
 use super::TriangleBvh;
 use super::avx;
-use crate::accel::wide::{Q, QNode8, WIDTH};
-
-/// `avx::slab8` with each row decoded by one fused multiply-add: q * step is exact (a
-/// power of two), so fma(q, step, origin) rounds once, as origin + q * step does: the same
-/// planes, bit for bit, 3-4 cycles sooner on each node's dependency chain.
-#[target_feature(enable = "avx512f,avx512vl")]
-#[inline]
-pub(super) fn slab8(
-    n: &QNode8,
-    o: Vec3A,
-    inv: Vec3A,
-    toward_neg: [bool; 3],
-    t_min: f32,
-    t_max: f32,
-    t_enter: &mut [f32; WIDTH],
-) -> u32 {
-    let slab = |a: usize| {
-        let (entry, exit) = n.entry_exit(a, toward_neg[a]);
-        let (o, inv) = (_mm256_set1_ps(o[a]), _mm256_set1_ps(inv[a]));
-        let (origin, step) = (_mm256_set1_ps(n.origin[a]), _mm256_set1_ps(n.step[a]));
-        let dist = |row: &[Q; WIDTH]| {
-            let q = _mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(avx::load_q(row)));
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_fmadd_ps(q, step, origin), o), inv)
-        };
-        (dist(entry), dist(exit))
-    };
-    let (nx, fx) = slab(0);
-    let (ny, fy) = slab(1);
-    let (nz, fz) = slab(2);
-    let (t_min, t_max) = (_mm256_set1_ps(t_min), _mm256_set1_ps(t_max));
-    let (near, mask) = avx::slab_tail([nx, ny, nz], [fx, fy, fz], t_min, t_max);
-    avx::store8(t_enter, near);
-    mask & u32::from(n.used)
-}
+use crate::accel::wide::WIDTH;
 
 /// `avx::leaf8` with AVX-512VL mask registers: the same eight lanes, the same operations in
 /// the same order (no FMA), the tests' results in mask registers instead of blends, so t is

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::{Tri, TriangleBvh, has_avx, soa_len};
 use crate::accel::sah::{self, PrimRef};
-use crate::accel::wide::{self, Node8, QNode8, WIDTH};
+use crate::accel::wide::{self, Node8, WIDTH};
 use crate::geometry::Aabb;
 
 impl TriangleBvh {
@@ -38,14 +38,7 @@ impl TriangleBvh {
         let Some(root) = sah::build(&mut prims, block) else {
             return TriangleBvh::default();
         };
-        let boxes = wide::collapse(&root);
-        let root_box = boxes.first().map_or(Aabb::EMPTY, Node8::bounds);
-        let nodes: Vec<QNode8> = boxes
-            .par_iter()
-            .with_min_len(1024)
-            .map(QNode8::quantise)
-            .collect();
-        drop(boxes);
+        let nodes = wide::collapse(&root);
         // The temporary tree is freed on another thread while the triangles are copied.
         let ((tris, ids), ()): ((Vec<Tri>, Vec<u32>), ()) = rayon::join(
             || {
@@ -68,6 +61,7 @@ impl TriangleBvh {
             },
             move || drop(root),
         );
+        let root = nodes.first().map_or(Aabb::EMPTY, Node8::bounds);
         let stride = tris.len();
         let mut soa = vec![0.0f32; soa_len(stride)];
         for (i, t) in tris.iter().enumerate() {
@@ -82,8 +76,8 @@ impl TriangleBvh {
             soa,
             stride,
             ids,
-            root_lo: root_box.min.into(),
-            root_hi: root_box.max.into(),
+            root_lo: root.min.into(),
+            root_hi: root.max.into(),
         }
     }
 }

@@ -32,12 +32,8 @@ impl TriangleBvh {
     }
 
     /// Checks the BVH invariants against the mesh it was built from (for tests): every
-    /// triangle in exactly one leaf, every decoded (quantised) box around all the triangles
-    /// below it, each node reached once, depth within the cap.
-    ///
-    /// Boxes are checked against the triangles, not against their parent's box: each
-    /// quantised box rounds outward on its own node's grid, so a child node's boxes may
-    /// poke out of the box its parent decodes for it, which costs a ray nothing.
+    /// triangle in exactly one leaf, every leaf box around its triangles, every node's boxes
+    /// inside the box its parent holds for it, each node reached once, depth within the cap.
     pub fn check_invariants(
         &self,
         positions: &[Vec3],
@@ -49,6 +45,7 @@ impl TriangleBvh {
 
     fn invariants(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), String> {
         let vert = |i: u32| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+        let tri_box = |t: &[u32; 3]| Aabb::from_points(&[vert(t[0]), vert(t[1]), vert(t[2])]);
         if triangles.is_empty() {
             return if self.nodes.is_empty() && self.ids.is_empty() {
                 Ok(())
@@ -68,9 +65,51 @@ impl TriangleBvh {
         }
         let mut seen = vec![0u32; triangles.len()];
         let mut reached = vec![0u32; self.nodes.len()];
-        let all = self.subtree(0, 0, triangles, &vert, &mut seen, &mut reached)?;
-        if !self.bounds().contains(&all) {
-            return Err("the root box does not contain the mesh".into());
+        // (node, the box its parent holds for it, depth)
+        let mut stack = vec![(0usize, None::<Aabb>, 0usize)];
+        while let Some((i, parent_box, depth)) = stack.pop() {
+            let n = self.nodes.get(i).ok_or(format!("node {i} out of range"))?;
+            reached[i] += 1;
+            if depth > sah::MAX_DEPTH {
+                return Err(format!("node {i} at depth {depth}, past the cap"));
+            }
+            let mut used = 0;
+            for s in 0..WIDTH {
+                if n.slot_is_empty(s) {
+                    continue;
+                }
+                used += 1;
+                let b = n.slot_bounds(s);
+                if let Some(pb) = parent_box
+                    && !pb.contains(&b)
+                {
+                    return Err(format!("node {i} slot {s} escapes its parent's box"));
+                }
+                let c = n.child[s];
+                if wide::is_leaf(c) {
+                    let (first, count) = wide::leaf_range(c);
+                    let ids = self
+                        .ids
+                        .get(first..first + count)
+                        .ok_or(format!("leaf range {first}+{count} out of bounds"))?;
+                    for &id in ids {
+                        let t = triangles
+                            .get(id as usize)
+                            .ok_or(format!("bad triangle id {id}"))?;
+                        if !b.contains(&tri_box(t)) {
+                            return Err(format!(
+                                "leaf box in node {i} does not contain triangle {id}"
+                            ));
+                        }
+                        seen[id as usize] += 1;
+                    }
+                } else {
+                    stack.push((c as usize, Some(b), depth + 1));
+                }
+            }
+            if used == 0 {
+                return Err(format!("node {i} has no children"));
+            }
         }
         if let Some(p) = seen.iter().position(|&s| s != 1) {
             return Err(format!("triangle {p} appears in {} leaves", seen[p]));
@@ -87,58 +126,5 @@ impl TriangleBvh {
             }
         }
         Ok(())
-    }
-
-    /// Checks node `i` at `depth` and everything below it; returns the box of the triangles
-    /// under it.
-    fn subtree(
-        &self,
-        i: usize,
-        depth: usize,
-        triangles: &[[u32; 3]],
-        vert: &impl Fn(u32) -> Vec3,
-        seen: &mut [u32],
-        reached: &mut [u32],
-    ) -> Result<Aabb, String> {
-        let n = self.nodes.get(i).ok_or(format!("node {i} out of range"))?;
-        reached[i] += 1;
-        if reached[i] > 1 {
-            return Err(format!("node {i} reached twice"));
-        }
-        if depth > sah::MAX_DEPTH {
-            return Err(format!("node {i} at depth {depth}, past the cap"));
-        }
-        if n.used == 0 {
-            return Err(format!("node {i} has no children"));
-        }
-        let mut all = Aabb::EMPTY;
-        for s in (0..WIDTH).filter(|&s| !n.slot_is_empty(s)) {
-            let c = n.child[s];
-            let below = if wide::is_leaf(c) {
-                let (first, count) = wide::leaf_range(c);
-                let ids = self
-                    .ids
-                    .get(first..first + count)
-                    .ok_or(format!("leaf range {first}+{count} out of bounds"))?;
-                let mut b = Aabb::EMPTY;
-                for &id in ids {
-                    let t = triangles
-                        .get(id as usize)
-                        .ok_or(format!("bad triangle id {id}"))?;
-                    b = b.union(Aabb::from_points(&[vert(t[0]), vert(t[1]), vert(t[2])]));
-                    seen[id as usize] += 1;
-                }
-                b
-            } else {
-                self.subtree(c as usize, depth + 1, triangles, vert, seen, reached)?
-            };
-            if !n.slot_bounds(s).contains(&below) {
-                return Err(format!(
-                    "node {i} slot {s}'s box does not contain the triangles below it"
-                ));
-            }
-            all = all.union(below);
-        }
-        Ok(all)
     }
 }

@@ -15,7 +15,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::wide::{QNode8, WIDTH};
+use super::wide::{Node8, WIDTH};
 use crate::geometry::{Aabb, moller_trumbore};
 
 #[cfg(target_arch = "x86_64")]
@@ -33,14 +33,12 @@ mod traverse;
 /// never culls a box the ray touches: 1 + 2γ₃ (Ize, "Robust BVH Ray Traversal", 2013), where
 /// γ₃ = 3u/(1 − 3u) with u = 2⁻²⁴ bounds the relative error of three roundings (the
 /// subtraction, the reciprocal, the product) in each of near and far. In f32 that is
-/// 1 + 3 ulps of 1 (`1.0 + 3.0 * f32::EPSILON`, checked by a test). The nodes' quantised
-/// planes are decoded first, exactly as the builder evaluated them when it checked that they
-/// contain the child boxes (`wide::QNode8`), so the three roundings are still all there is.
+/// 1 + 3 ulps of 1 (`1.0 + 3.0 * f32::EPSILON`, checked by a test).
 const SLAB_WIDEN: f32 = 1.000_000_4;
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleBvh {
-    nodes: Vec<QNode8>,
+    nodes: Vec<Node8>,
     /// Triangles in leaf order, one array per component (v0.x, v0.y, v0.z, e1.x, ... e2.z,
     /// each `stride` = triangle count long), so a leaf's up to eight triangles load as one
     /// 8-lane vector per component; lanes past the leaf (the next component's values, or 7
@@ -79,17 +77,13 @@ impl Tri {
 }
 
 impl TriangleBvh {
-    /// The mesh's box, exact (the root's quantised boxes may be a little larger).
     pub fn bounds(&self) -> Aabb {
-        if self.nodes.is_empty() {
-            return Aabb::EMPTY;
-        }
-        Aabb::new(self.root_lo.into(), self.root_hi.into())
+        self.nodes.first().map_or(Aabb::EMPTY, Node8::bounds)
     }
 
     /// Bytes held by the nodes and the triangle copies.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<QNode8>() + self.soa.len() * 4 + self.ids.len() * 4
+        self.nodes.len() * std::mem::size_of::<Node8>() + self.soa.len() * 4 + self.ids.len() * 4
     }
 
     /// Triangle `i` (leaf order) from the component arrays; zeros past the end.
@@ -104,8 +98,8 @@ impl TriangleBvh {
     }
 }
 
-/// Whether a ray can be traversed: a NaN or infinite ray makes every slab test NaN, which
-/// enters every box (the tests drop NaN axes), so it would walk the whole tree.
+/// Whether a ray can be traversed: with finite origin and direction an empty slot's box
+/// (+inf..-inf) gives an infinite, never NaN, slab on every axis, so it is never entered.
 #[inline(always)]
 fn finite_ray(o: Vec3A, d: Vec3A) -> bool {
     o.is_finite() && d.is_finite()

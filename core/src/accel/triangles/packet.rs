@@ -7,7 +7,7 @@ use glam::Vec3A;
 use std::arch::x86_64::*;
 
 #[cfg(target_arch = "x86_64")]
-use super::avx::{self, decode_row, load8, slab_tail, store8};
+use super::avx::{self, load_row, load8, slab_tail, store8};
 #[cfg(target_arch = "x86_64")]
 use super::traverse::nearest_first;
 #[cfg(target_arch = "x86_64")]
@@ -15,7 +15,7 @@ use super::{SLAB_WIDEN, has_avx};
 use super::{TriangleBvh, TriangleHit};
 use crate::accel::wide::WIDTH;
 #[cfg(target_arch = "x86_64")]
-use crate::accel::wide::{self, Child, QNode8, RayStack};
+use crate::accel::wide::{self, Child, Node8, RayStack};
 
 /// A sparse packet whose first `INCOHERENT_AFTER_LEAVES` leaves are each entered by fewer
 /// than `INCOHERENT_RAYS_PER_LEAF` of its rays on average is incoherent (rays far apart on a
@@ -218,9 +218,7 @@ impl TriangleBvh {
 /// the right corner bounds every ray's value, bit-exactly rather than approximately: for the
 /// near plane the lower bound is (plane - o_far) * (inv_min where that difference is >= 0,
 /// else inv_max), with o_far = o_max on a + axis and o_min on a - axis; the far plane's
-/// upper bound mirrors it. Finite, nonzero reciprocals (checked in `new`) keep NaN out,
-/// but for a node axis that decodes to NaN (`QNode8`): it is NaN in the packet's test and in
-/// every ray's own, in the same lanes, so `slab_tail` drops the same terms from both.
+/// upper bound mirrors it. Finite, nonzero reciprocals (checked in `new`) keep NaN out.
 #[cfg(target_arch = "x86_64")]
 pub(super) struct PacketBounds {
     /// Per axis: do the rays run toward -axis?
@@ -336,7 +334,7 @@ impl PacketBounds {
     /// `t_enter` gets lower bounds of the rays' entry distances.
     #[target_feature(enable = "avx")]
     #[inline]
-    fn slab8(&self, n: &QNode8, t_min: f32, t_far: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
+    fn slab8(&self, n: &Node8, t_min: f32, t_far: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
         let (sub, mul, blend, set) = (
             _mm256_sub_ps,
             _mm256_mul_ps,
@@ -347,8 +345,8 @@ impl PacketBounds {
             let (entry, exit) = n.entry_exit(a, self.toward_neg[a]);
             let (lo, hi) = (set(self.inv_min[a]), set(self.inv_max[a]));
             // blendv takes its second operand where the difference is negative.
-            let x = sub(decode_row(n, a, entry), set(self.o_near[a]));
-            let y = sub(decode_row(n, a, exit), set(self.o_far[a]));
+            let x = sub(load_row(entry), set(self.o_near[a]));
+            let y = sub(load_row(exit), set(self.o_far[a]));
             (mul(x, blend(lo, hi, x)), mul(y, blend(hi, lo, y)))
         };
         let (nx, fx) = side(0);
@@ -356,21 +354,22 @@ impl PacketBounds {
         let (nz, fz) = side(2);
         let (near, mask) = slab_tail([nx, ny, nz], [fx, fy, fz], set(t_min), set(t_far));
         store8(t_enter, near);
-        mask & u32::from(n.used)
+        mask
     }
 
     /// Bit i set when ray i's own slab test (`avx::slab8`'s operations in its order, lane i)
     /// enters slot `s` of `n` within [t_min, t_best[i]].
     #[target_feature(enable = "avx")]
     #[inline]
-    fn rays_entering(&self, n: &QNode8, s: usize, t_min: f32, t_best: &[f32; WIDTH]) -> u8 {
+    fn rays_entering(&self, n: &Node8, s: usize, t_min: f32, t_best: &[f32; WIDTH]) -> u8 {
         let (sub, mul, set) = (_mm256_sub_ps, _mm256_mul_ps, _mm256_set1_ps);
+        let (h, l) = (s / 4, s % 4);
         let slab = |a: usize| {
             let (entry, exit) = n.entry_exit(a, self.toward_neg[a]);
             let (o, inv) = (self.o[a], self.inv[a]);
             (
-                mul(sub(set(n.decode(a, entry[s])), o), inv),
-                mul(sub(set(n.decode(a, exit[s])), o), inv),
+                mul(sub(set(entry[h][l]), o), inv),
+                mul(sub(set(exit[h][l]), o), inv),
             )
         };
         let (nx, fx) = slab(0);

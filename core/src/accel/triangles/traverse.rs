@@ -8,7 +8,7 @@ use super::avx::{self, LeafRay};
 #[cfg(target_arch = "x86_64")]
 use super::avx512;
 use super::{SLAB_WIDEN, TriangleBvh, TriangleHit, finite_ray, has_avx, has_avx512};
-use crate::accel::wide::{self, Child, QNode8, RayStack, StackEntry, WIDTH};
+use crate::accel::wide::{self, Child, Node8, RayStack, StackEntry, WIDTH};
 use crate::geometry::Ray;
 
 /// A ray set up for the slab tests: origin, direction, reciprocal direction, and per axis
@@ -48,14 +48,10 @@ impl SlabRay {
     /// Entry distances of all eight slots into `t_enter`; bit i of the result is set when
     /// slot i is entered within [t_min, t_max]. Two SSE halves; `avx::slab8` is one register.
     #[inline(always)]
-    fn slab8(&self, n: &QNode8, t_min: f32, t_max: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
-        let rows = |a: usize| {
-            let (entry, exit) = n.entry_exit(a, self.toward_neg[a]);
-            (n.decode_row(a, entry), n.decode_row(a, exit))
-        };
-        let (nx, fx) = rows(0);
-        let (ny, fy) = rows(1);
-        let (nz, fz) = rows(2);
+    fn slab8(&self, n: &Node8, t_min: f32, t_max: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
+        let (nx, fx) = n.entry_exit(0, self.toward_neg[0]);
+        let (ny, fy) = n.entry_exit(1, self.toward_neg[1]);
+        let (nz, fz) = n.entry_exit(2, self.toward_neg[2]);
         let (o, inv) = (self.o, self.inv);
         let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
         let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
@@ -77,7 +73,7 @@ impl SlabRay {
         let (lo, hi) = t_enter.split_at_mut(4);
         lo.copy_from_slice(&near[0].to_array());
         hi.copy_from_slice(&near[1].to_array());
-        mask & u32::from(n.used)
+        mask
     }
 }
 
@@ -150,7 +146,7 @@ fn closest_hit_with<const FIRST: bool>(
     r: &SlabRay,
     t_min: f32,
     t_max: f32,
-    slab8: impl Fn(&SlabRay, &QNode8, f32, f32, &mut [f32; WIDTH]) -> u32,
+    slab8: impl Fn(&SlabRay, &Node8, f32, f32, &mut [f32; WIDTH]) -> u32,
     leaf: impl Fn(&SlabRay, usize, usize, f32, f32) -> Option<(f32, usize)>,
 ) -> Option<TriangleHit> {
     if bvh.nodes.is_empty() || !r.enters(bvh.root_lo, bvh.root_hi, t_min, t_max) {
@@ -209,7 +205,7 @@ impl TriangleBvh {
     #[inline]
     pub fn closest_hit(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         // A NaN or infinite ray (an overflowing object-space transform) makes every slab
-        // test NaN, which enters every box: the whole tree for nothing.
+        // test NaN, which would enter the empty slots, whose child is the root: endless.
         if !finite_ray(o, d) {
             return None;
         }
@@ -291,7 +287,7 @@ impl TriangleBvh {
             t_min,
             t_max,
             |r, n, t_min, t_max, t_enter| {
-                avx512::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
             |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
         )
@@ -362,7 +358,7 @@ impl TriangleBvh {
             t_min,
             t_max,
             |r, n, t_min, t_max, t_enter| {
-                avx512::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
             |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
         )
