@@ -1,5 +1,5 @@
 //! The progressive, cancellable renderer. A render runs in passes from coarse (one ray per
-//! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
+//! 16×16 block) to full resolution; each pass traces only the pixels no earlier pass traced,
 //! so the last pass leaves exactly the image a single full pass would. The passes between a
 //! coarse pass and the full one are left out when that coarse pass shows the full image will
 //! come quickly. Tiles are rendered in parallel with rayon and copied into a shared frame
@@ -97,7 +97,7 @@ pub struct PassInfo {
     /// Passes this render makes: fewer from a quick coarse pass on, which skips the passes
     /// between it and the full one.
     pub passes: usize,
-    /// Pixels per traced sample along each axis in this pass (8, 4, 2, then 1).
+    /// Pixels per traced sample along each axis in this pass (16, 8, 4, 2, then 1).
     pub scale: u32,
     /// Time since the render started.
     pub elapsed: Duration,
@@ -610,8 +610,8 @@ mod tests {
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
     /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
     /// written whole and those written tile by tile, packets and single rays, every pass made
-    /// and a quick 8× pass going straight to the full one (which then fills in around the 8×
-    /// grid), or a full pass after the 4× one.
+    /// and a quick 16× pass going straight to the full one (which then fills in around the
+    /// 16× grid), or a full pass after the 4× one.
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -631,8 +631,8 @@ mod tests {
             for tracing in [Tracing::Packets, Tracing::SingleRays] {
                 // (plan, bound, the passes shown, PassInfo::passes after each)
                 let plans: [(&[u32], _, &[u32], &[usize]); 3] = [
-                    (&SCALES, None, &SCALES, &[4, 4, 4, 4]),
-                    (&SCALES, Some(Duration::MAX), &[8, 1], &[2, 2]),
+                    (&SCALES, None, &SCALES, &[5, 5, 5, 5, 5]),
+                    (&SCALES, Some(Duration::MAX), &[16, 1], &[2, 2]),
                     (&[8, 4, 1], None, &[8, 4, 1], &[3, 3, 3]),
                 ];
                 for (plan, skip, scales, passes) in plans {
@@ -668,31 +668,34 @@ mod tests {
     }
 
     /// A coarse pass skips the passes between it and the full one when the full pass's rays
-    /// would take less than the bound at its time per ray. At 800², the 8× pass traces 10,000
-    /// rays and leaves 630,000 (250 ms allows 3.97 ms); the 4× pass traces 30,000 and leaves
-    /// 600,000 (12.5 ms).
+    /// would take less than the bound at its time per ray. At 800², the 16× pass traces 2,500
+    /// rays and leaves 637,500 (250 ms allows 0.98 ms); the 8× pass traces 7,500 and leaves
+    /// 630,000 (2.98 ms); the 4× pass traces 30,000 and leaves 600,000 (12.5 ms).
     #[test]
     fn a_quick_coarse_pass_goes_straight_to_the_full_one() {
         let ms = Duration::from_millis;
         let us = Duration::from_micros;
         let below = Some(STRAIGHT_TO_FULL_BELOW);
         assert_eq!(STRAIGHT_TO_FULL_BELOW, ms(250));
+        assert_eq!(SCALES, [16, 8, 4, 2, 1]);
         let skip = |plan: &[u32], pass, took, size| passes_to_skip(plan, pass, took, size, below);
-        assert_eq!(skip(&SCALES, 0, us(3_950), (800, 800)), 2);
-        assert_eq!(skip(&SCALES, 0, us(4_000), (800, 800)), 0);
-        assert_eq!(skip(&SCALES, 1, ms(12), (800, 800)), 1);
-        assert_eq!(skip(&SCALES, 1, ms(13), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 0, us(975), (800, 800)), 3);
+        assert_eq!(skip(&SCALES, 0, us(985), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 1, us(2_950), (800, 800)), 2);
+        assert_eq!(skip(&SCALES, 1, us(3_000), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 2, ms(12), (800, 800)), 1);
+        assert_eq!(skip(&SCALES, 2, ms(13), (800, 800)), 0);
         // Any size leaves about the same multiple of a pass's rays: the time per ray decides.
-        assert_eq!(skip(&SCALES, 1, ms(12), (3840, 2160)), 1);
-        assert_eq!(skip(&SCALES, 1, ms(13), (3840, 2160)), 0);
+        assert_eq!(skip(&SCALES, 2, ms(12), (3840, 2160)), 1);
+        assert_eq!(skip(&SCALES, 2, ms(13), (3840, 2160)), 0);
         assert_eq!(passes_to_skip(&SCALES, 0, ms(1), (800, 800), None), 0);
         assert_eq!(
-            skip(&SCALES, 2, ms(1), (800, 800)),
+            skip(&SCALES, 3, ms(1), (800, 800)),
             0,
             "nothing between 2× and 1×"
         );
         assert_eq!(
-            skip(&SCALES[..2], 0, ms(1), (800, 800)),
+            skip(&SCALES[..3], 0, ms(1), (800, 800)),
             0,
             "the coarse passes alone"
         );
