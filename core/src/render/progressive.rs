@@ -7,88 +7,25 @@
 //! at once in the coarse ones (cheap to trace, dear to write); a cancel flag stops the work
 //! within one tile.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
 use super::camera::PixelRays;
+use super::coarse::CoarseFrame;
 use super::compile::CompiledScene;
 use super::cull::TileCull;
 use super::frame::{Frame, Sample, write_sample};
 use super::plan::{Cancel, RenderPlan, Schedule, Tracing, Uncancellable};
 use super::shade::shade_fast;
 use super::shade_lanes::shade_packet;
+use super::shared_frame::SharedFrame;
 use super::whitted::{needs_whitted, shade_primary};
 use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
 const TILE: u32 = 64;
-
-/// A frame being filled by a render and read by others (the GUI) while it fills.
-#[derive(Debug)]
-pub struct SharedFrame {
-    frame: Mutex<Frame>,
-    /// Bumped whenever pixels change, so readers copy only when there is something new.
-    version: AtomicU64,
-    /// Tiles finished and tiles planned in the current render, over all passes.
-    tiles_done: AtomicU64,
-    tiles_total: AtomicU64,
-}
-
-impl Default for SharedFrame {
-    fn default() -> Self {
-        SharedFrame {
-            frame: Mutex::new(Frame::new(0, 0)),
-            version: AtomicU64::new(0),
-            tiles_done: AtomicU64::new(0),
-            tiles_total: AtomicU64::new(0),
-        }
-    }
-}
-
-impl SharedFrame {
-    pub fn new() -> Self {
-        Self::default()
-    }
-    /// A `width` × `height` frame allocated now, fallibly: a render of that size into it
-    /// allocates no frame of its own.
-    pub fn try_sized(width: u32, height: u32) -> Result<Self, crate::memory::OutOfMemory> {
-        let shared = Self::new();
-        *shared.lock() = Frame::try_new(width, height)?;
-        Ok(shared)
-    }
-    /// The frame as it is now. Hold the guard briefly: the renderer waits for it.
-    pub fn lock(&self) -> MutexGuard<'_, Frame> {
-        self.frame.lock().unwrap_or_else(PoisonError::into_inner)
-    }
-    /// The frame, leaving an empty one: a finished render's image as a value.
-    pub fn take(&self) -> Frame {
-        std::mem::replace(&mut *self.lock(), Frame::new(0, 0))
-    }
-    /// Puts a whole finished image in place (one not rendered by passes, such as
-    /// `-visualize_grid`'s), so readers see it as new.
-    pub fn set(&self, frame: Frame) {
-        *self.lock() = frame;
-        self.bump();
-    }
-    pub fn version(&self) -> u64 {
-        self.version.load(Ordering::Acquire)
-    }
-    /// Fraction of the current render's work done, in [0, 1].
-    pub fn progress(&self) -> f32 {
-        let total = self.tiles_total.load(Ordering::Relaxed);
-        if total == 0 {
-            0.0
-        } else {
-            self.tiles_done.load(Ordering::Relaxed) as f32 / total as f32
-        }
-    }
-    fn bump(&self) {
-        self.version.fetch_add(1, Ordering::AcqRel);
-    }
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassInfo {
@@ -393,11 +330,51 @@ fn trace_tile(
     grid
 }
 
-/// Passes this coarse or coarser are traced whole and then written in one go, the bands of
-/// tile rows in parallel: their rays are few, and written tile by tile under the frame's lock
-/// the blocks' copies (the whole frame, for a sixteenth of the rays or less) kept all but one
-/// thread waiting (docs/perf.md).
+/// Passes this coarse or coarser are traced whole and kept at their own resolution
+/// ([`CoarseFrame`], spread over the frame when it is read): their rays are few, and written
+/// tile by tile under the frame's lock the blocks' copies (the whole frame, for a sixteenth of
+/// the rays or less) kept all but one thread waiting (docs/perf.md).
 const WRITE_WHOLE_FROM_SCALE: u32 = 4;
+
+/// A whole pass's tile grids as one grid over the frame (the points traced before unset).
+fn gather(traced: &[(TilePass, Vec<Sample>)], w: u32, h: u32, scale: u32) -> CoarseFrame {
+    let gw = w.div_ceil(scale) as usize;
+    let mut samples = vec![Sample::UNSET; gw * h.div_ceil(scale) as usize];
+    for (tp, grid) in traced {
+        // Tile corners are multiples of every scale.
+        let (i0, j0) = ((tp.x0 / scale) as usize, (tp.y0 / scale) as usize);
+        for (j, row) in grid.chunks(tp.gw as usize).enumerate() {
+            let at = (j0 + j) * gw + i0;
+            samples[at..at + row.len()].copy_from_slice(row);
+        }
+    }
+    CoarseFrame {
+        width: w,
+        height: h,
+        scale,
+        samples,
+    }
+}
+
+/// The points of `grid` the pass at scale `coarser` traced (every ratio-th of this grid),
+/// from that pass: kept coarse, or spread over the frame since.
+fn fill_traced_before(grid: &mut CoarseFrame, coarser: u32, p: &super::shared_frame::Pixels) {
+    let ratio = (coarser / grid.scale) as usize;
+    let (gw, gh) = (grid.grid_width() as usize, grid.grid_height() as usize);
+    for j in (0..gh).step_by(ratio) {
+        for i in (0..gw).step_by(ratio) {
+            let (x, y) = ((i as u32) * grid.scale, (j as u32) * grid.scale);
+            let before = match &p.coarse {
+                Some(c) => c.get(x, y),
+                None => p.frame.get(x, y),
+            };
+            // Always there: the coarser pass covered this frame (a reader spreads it whole).
+            if let Some(&s) = before {
+                grid.samples[j * gw + i] = s;
+            }
+        }
+    }
+}
 
 /// Passes this coarse or coarser let an incoherent packet go one ray at a time
 /// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
@@ -446,9 +423,7 @@ fn render_scales<C: Cancel>(
     let (w, h) = (settings.width, settings.height);
     if settings.variant.is_some() {
         // A mistake's picture (diff's diagnosis): one plain pass, nothing of the fast path.
-        let frame = super::mistakes::render_variant(scene, settings);
-        *target.lock() = frame;
-        target.bump();
+        target.set(super::mistakes::render_variant(scene, settings));
         on_pass(PassInfo {
             pass: 0,
             passes: 1,
@@ -458,9 +433,13 @@ fn render_scales<C: Cancel>(
         return Ok(());
     }
     {
-        let mut f = target.lock();
-        if f.width != w || f.height != h {
-            *f = Frame::new(w, h);
+        let mut p = target.pixels();
+        p.coarse = None;
+        // A first pass kept coarse leaves the frame to be sized when it is spread (the editor
+        // renders into fresh frames: 10 MB less to allocate and fill before the first image).
+        let kept_coarse = scales.first().is_some_and(|&s| s >= WRITE_WHOLE_FROM_SCALE);
+        if (p.frame.width != w || p.frame.height != h) && !(kept_coarse && w > 0 && h > 0) {
+            p.frame = Frame::new(w, h);
         }
     }
     target.bump();
@@ -512,30 +491,25 @@ fn render_scales<C: Cancel>(
                     Ok((tp, grid))
                 })
                 .collect::<Result<_, _>>()?;
-            let mut bands: Vec<Vec<(TilePass, Vec<Sample>)>> =
-                (0..tiles_y).map(|_| Vec::new()).collect();
-            for (tp, grid) in traced {
-                bands[(tp.y0 / TILE) as usize].push((tp, grid));
+            let mut grid = gather(&traced, w, h, scale);
+            let mut p = target.pixels();
+            if let Some(coarser) = coarser {
+                fill_traced_before(&mut grid, coarser, &p);
             }
-            // Held across the parallel write (about 1 ms at 800², longer for larger frames; a
-            // reader waits that long). No job under it locks this frame, nor can a stolen one:
-            // a render's tile-by-tile passes never overlap its whole-pass writes, and two
-            // renders never share a frame at once (the editor gives each render fresh ones).
-            let mut f = target.lock();
-            let band_len = (w * TILE) as usize;
-            f.samples
-                .par_chunks_mut(band_len)
-                .zip(bands.par_iter_mut())
-                .enumerate()
-                .for_each(|(b, (band, tiles))| {
-                    let mut line = Vec::with_capacity(TILE as usize);
-                    for (tp, grid) in tiles {
-                        write_tile(band, w as usize, b as u32 * TILE, tp, grid, &mut line);
-                    }
-                });
-            drop(f);
+            p.coarse = Some(grid);
+            drop(p);
             target.bump();
         } else {
+            if let Some(stop) = cancel.stop() {
+                return Err(stop);
+            }
+            {
+                // The tiles read the coarser pass's points back from the frame.
+                let mut p = target.pixels();
+                if let Some(c) = p.coarse.take() {
+                    c.spread_into(&mut p.frame, true);
+                }
+            }
             tiles.par_iter().try_for_each(|t| {
                 if let Some(stop) = cancel.stop() {
                     return Err(stop);
@@ -664,6 +638,63 @@ mod tests {
                     assert_eq!(target.progress(), 1.0);
                 }
             }
+        }
+    }
+
+    /// Coarse passes nobody reads stay at their own resolution, each taking the points of the
+    /// one before from that one's grid: what `coarse()` shows after each, unread, is the
+    /// blocks of the full render, the frame is untouched (a fresh frame stays unsized until
+    /// read), and the full pass then starts from them and ends with the full render.
+    #[test]
+    fn unread_coarse_passes_chain_at_their_own_resolution() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/nested_transforms.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
+        let c = CompiledScene::new(&scene);
+        for (w, h) in [(150u32, 97u32), (7, 130)] {
+            let s = RenderSettings::new(w, h);
+            let full = render_frame(&c, &s);
+            let target = SharedFrame::new();
+            let mut shown = Vec::new();
+            let schedule = Schedule {
+                scales: &SCALES,
+                straight_to_full_below: None,
+                tracing: Tracing::Packets,
+            };
+            let Ok(()) = render_scales(&c, &s, schedule, &target, &Uncancellable, &mut |p| {
+                let coarse = target.coarse();
+                // What readers that do not lock see: the pass shown, at the frame's size.
+                let now = target.shown();
+                assert_eq!(now.size(), (w, h));
+                for (x, y) in [(0, 0), (w - 1, h - 1), (w / 2, h / 3), (w, 0), (0, h)] {
+                    let want = match &coarse {
+                        Some(c) => c.get(x, y),
+                        None => now.0.frame.get(x, y),
+                    };
+                    assert_eq!(now.get(x, y), want);
+                }
+                drop(now);
+                shown.push((p.scale, coarse, target.pixels().frame.width));
+            });
+            for (scale, coarse, frame_width) in &shown {
+                if *scale < WRITE_WHOLE_FROM_SCALE {
+                    assert!(coarse.is_none(), "{scale}× is written into the frame");
+                    continue;
+                }
+                let coarse = coarse.as_ref().expect("kept coarse");
+                assert_eq!((coarse.scale, *frame_width), (*scale, 0), "{w}x{h}");
+                let f = coarse.spread();
+                for y in 0..h {
+                    for x in 0..w {
+                        let corner = full.get(x - x % scale, y - y % scale);
+                        assert_eq!(f.get(x, y), corner, "{w}x{h} {scale}× ({x}, {y})");
+                    }
+                }
+            }
+            assert_eq!(*target.lock(), full, "{w}x{h}");
         }
     }
 
