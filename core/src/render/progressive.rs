@@ -2,10 +2,10 @@
 //! 16×16 block) to full resolution; each pass traces only the pixels no earlier pass traced,
 //! so the last pass leaves exactly the image a single full pass would. The passes between a
 //! coarse pass and the full one are left out when that coarse pass shows the full image will
-//! come quickly. Tiles are rendered in parallel with rayon and copied into a shared frame
-//! that another thread may read at any time: tile by tile in the fine passes, a whole pass
-//! at once in the coarse ones (cheap to trace, dear to write); a cancel flag stops the work
-//! within one tile.
+//! come quickly. Tiles are rendered in parallel with rayon into a shared frame that another
+//! thread may read at any time: tile by tile in the fine passes; in the coarse ones (cheap to
+//! trace, dear to write) a whole pass at once, kept at its own resolution until the frame is
+//! read or a fine pass needs it. A cancel flag stops the work within one tile.
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -504,7 +504,9 @@ fn render_scales<C: Cancel>(
                 return Err(stop);
             }
             {
-                // The tiles read the coarser pass's points back from the frame.
+                // The tiles read the coarser pass's points back from the frame. Spread under
+                // the lock, in parallel: no job under it locks this frame, nor can a stolen one
+                // (this render's tiles start after it; two renders never share a frame).
                 let mut p = target.pixels();
                 if let Some(c) = p.coarse.take() {
                     c.spread_into(&mut p.frame, true);
