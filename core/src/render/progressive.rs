@@ -380,6 +380,11 @@ fn fill_traced_before(grid: &mut CoarseFrame, coarser: u32, p: &super::shared_fr
 /// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
 const SPARSE_FROM_SCALE: u32 = 4;
 
+/// Passes this fine or finer may skip to the full pass. A 16× pass does not: its few rays
+/// leave the tree cold for the full pass, which then took longer than the 8× pass it skipped
+/// (the dragon's full image 19.4 → 21.5 ms, docs/perf.md).
+const SKIP_FROM_SCALE: u32 = 8;
+
 /// How many passes to skip after pass `pass` of `plan`, which took `took`: those between it
 /// and the full-resolution pass that ends the plan, when the full pass's rays would take
 /// less than `below` at this pass's time per ray.
@@ -390,7 +395,9 @@ fn passes_to_skip(
     (w, h): (u32, u32),
     below: Option<Duration>,
 ) -> usize {
-    let Some(below) = below else { return 0 };
+    let Some(below) = below.filter(|_| plan[pass] <= SKIP_FROM_SCALE) else {
+        return 0;
+    };
     let between = plan.len().saturating_sub(pass + 2);
     if between == 0 || plan.last() != Some(&1) {
         return 0;
@@ -586,8 +593,8 @@ mod tests {
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
     /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
     /// written whole and those written tile by tile, packets and single rays, every pass made
-    /// and a quick 16× pass going straight to the full one (which then fills in around the
-    /// 16× grid), or a full pass after the 4× one.
+    /// and a quick 8× pass going straight to the full one (which then fills in around the 8×
+    /// grid), or a full pass after the 4× one.
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -608,7 +615,7 @@ mod tests {
                 // (plan, bound, the passes shown, PassInfo::passes after each)
                 let plans: [(&[u32], _, &[u32], &[usize]); 3] = [
                     (&SCALES, None, &SCALES, &[5, 5, 5, 5, 5]),
-                    (&SCALES, Some(Duration::MAX), &[16, 1], &[2, 2]),
+                    (&SCALES, Some(Duration::MAX), &[16, 8, 1], &[5, 3, 3]),
                     (&[8, 4, 1], None, &[8, 4, 1], &[3, 3, 3]),
                 ];
                 for (plan, skip, scales, passes) in plans {
@@ -701,9 +708,9 @@ mod tests {
     }
 
     /// A coarse pass skips the passes between it and the full one when the full pass's rays
-    /// would take less than the bound at its time per ray. At 800², the 16× pass traces 2,500
-    /// rays and leaves 637,500 (250 ms allows 0.98 ms); the 8× pass traces 7,500 and leaves
-    /// 630,000 (2.98 ms); the 4× pass traces 30,000 and leaves 600,000 (12.5 ms).
+    /// would take less than the bound at its time per ray, the 16× pass never. At 800², the
+    /// 8× pass traces 7,500 rays after the 16× one and leaves 630,000 (250 ms allows 2.98 ms);
+    /// the 4× pass traces 30,000 and leaves 600,000 (12.5 ms).
     #[test]
     fn a_quick_coarse_pass_goes_straight_to_the_full_one() {
         let ms = Duration::from_millis;
@@ -712,8 +719,8 @@ mod tests {
         assert_eq!(STRAIGHT_TO_FULL_BELOW, ms(250));
         assert_eq!(SCALES, [16, 8, 4, 2, 1]);
         let skip = |plan: &[u32], pass, took, size| passes_to_skip(plan, pass, took, size, below);
-        assert_eq!(skip(&SCALES, 0, us(975), (800, 800)), 3);
-        assert_eq!(skip(&SCALES, 0, us(985), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 0, Duration::ZERO, (800, 800)), 0, "16× never");
+        assert_eq!(skip(&[16, 1], 0, Duration::ZERO, (800, 800)), 0);
         assert_eq!(skip(&SCALES, 1, us(2_950), (800, 800)), 2);
         assert_eq!(skip(&SCALES, 1, us(3_000), (800, 800)), 0);
         assert_eq!(skip(&SCALES, 2, ms(12), (800, 800)), 1);
@@ -728,7 +735,7 @@ mod tests {
             "nothing between 2× and 1×"
         );
         assert_eq!(
-            skip(&SCALES[..3], 0, ms(1), (800, 800)),
+            skip(&SCALES[..3], 1, us(1), (800, 800)),
             0,
             "the coarse passes alone"
         );
