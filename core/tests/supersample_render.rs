@@ -62,7 +62,12 @@ fn the_last_pass_is_the_filtered_film_over_the_centre_rays_other_views() {
         .expect("filtered");
     let last = passes.last().expect("passes");
     assert_eq!(last.pass + 1, last.passes, "{passes:?}");
-    assert!(passes.iter().all(|p| p.passes == last.passes), "{passes:?}");
+    // Fewer once a quick coarse pass skips the passes before the full one (how quick
+    // depends on the machine), never more: the supersampled pass is counted from the start.
+    assert!(
+        passes.windows(2).all(|w| w[0].passes >= w[1].passes),
+        "{passes:?}"
+    );
     let mut changed = 0;
     for ((g, p), f) in got.samples.iter().zip(&plain.samples).zip(&film.samples) {
         assert_eq!(g.color, f.color);
@@ -85,7 +90,7 @@ fn a_coarse_render_does_not_supersample_and_a_cancel_stops_it() {
         &Uncancellable,
         |p: PassInfo| passes.push(p),
     );
-    assert_eq!(passes.len(), 2, "{passes:?}");
+    assert_eq!(passes.len(), 3, "16×, 8× and 4×: {passes:?}");
     assert!(passes.iter().all(|p| p.scale > 1));
     let cancel = AtomicBool::new(true);
     assert!(

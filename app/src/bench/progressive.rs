@@ -111,7 +111,9 @@ pub fn run_progressive(b: &ProgressiveArgs) -> anyhow::Result<()> {
         "passes: {} ms each (scale, median; the first from the compile on)",
         passes.join(" + ")
     );
-    out!("PROGRESSIVE coarse_ms={coarse:.2} full_ms={full:.2}");
+    // Three decimals: a small scene's first coarse pass (a few rays, no frame written) takes
+    // microseconds.
+    out!("PROGRESSIVE coarse_ms={coarse:.3} full_ms={full:.2}");
     if let Some(steps) = b.orbit {
         run_orbit(&scene, &settings, steps.max(1))?;
     }
@@ -181,7 +183,7 @@ fn run_orbit(scene: &Scene, settings: &RenderSettings, steps: usize) -> anyhow::
         full.push(t_full.as_secs_f64() * 1e3);
     }
     out!(
-        "ORBIT steps={steps} first_ms={:.2} coarse_ms={:.2} full_ms={:.2} max_first_ms={:.2}",
+        "ORBIT steps={steps} first_ms={:.3} coarse_ms={:.3} full_ms={:.2} max_first_ms={:.3}",
         median(first.clone()),
         median(coarse_done),
         median(full),

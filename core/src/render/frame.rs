@@ -26,6 +26,22 @@ impl Sample {
     pub fn is_hit(&self) -> bool {
         self.node != u32::MAX
     }
+    /// The pixel's bytes in one view; `depth` is (min, max) for the depth view.
+    #[inline]
+    pub fn rgb8(&self, view: View, depth: (f32, f32)) -> [u8; 3] {
+        match view {
+            View::Color => self.color,
+            View::Normals => self.normal,
+            View::Depth => {
+                let g = if self.is_hit() {
+                    quantize(depth_shade(self.t, depth.0, depth.1))
+                } else {
+                    0
+                };
+                [g, g, g]
+            }
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -116,18 +132,7 @@ impl Frame {
 
     fn rgb8_into(&self, view: View, depth: (f32, f32), out: &mut Vec<u8>) {
         for s in &self.samples {
-            match view {
-                View::Color => out.extend_from_slice(&s.color),
-                View::Normals => out.extend_from_slice(&s.normal),
-                View::Depth => {
-                    let g = if s.is_hit() {
-                        quantize(depth_shade(s.t, depth.0, depth.1))
-                    } else {
-                        0
-                    };
-                    out.extend_from_slice(&[g, g, g]);
-                }
-            }
+            out.extend_from_slice(&s.rgb8(view, depth));
         }
     }
 

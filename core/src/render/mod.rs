@@ -2,6 +2,7 @@
 //! and depth views, and the progressive, cancellable driver.
 
 mod camera;
+mod coarse;
 mod compile;
 pub mod csg;
 mod cull;
@@ -23,11 +24,13 @@ pub mod sampling;
 mod shade;
 mod shade_lanes;
 mod shape;
+mod shared_frame;
 mod similitude;
 pub mod texture;
 mod whitted;
 
 pub use camera::CameraRays;
+pub use coarse::CoarseFrame;
 pub use compile::{CompiledScene, Hit, Object, PointLight, Shape};
 pub use film::{Film, FilmError, Picture, Supersampling, check_film, filter_picture};
 pub use filter::{Filter, FilterError};
@@ -39,11 +42,12 @@ pub use limits::{ImageSizeError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_image_s
 pub use mistakes::{Mistake, Variant};
 pub use object_rays::{ObjectRays, ObjectT};
 pub use plan::{Cancel, Cancelled, Passes, RenderPlan, Tracing, Uncancellable};
-pub use progressive::{PassInfo, SharedFrame, render, render_frame, try_render_frame};
+pub use progressive::{PassInfo, render, render_frame, try_render_frame};
 pub use rule_gap::{NormalGap, normal_rule_gap};
 pub use rules::{Ambient, Rules};
 pub use sampling::{DEFAULT_SEED, Sampler, SamplerError, SamplerKind};
 pub use shade::{LightTerm, ShadeInfo, shade_hit};
+pub use shared_frame::{FrameGuard, SharedFrame, ShownPixels};
 pub use similitude::{Breaks, SimilitudeTest, similitude, similitude_within};
 pub use whitted::{
     Blocker, Cut, LightShare, MAX_BOUNCES, MAX_SECONDARY_RAYS, RayKind, RayNode, SECONDARY_T_MIN,

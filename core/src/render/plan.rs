@@ -4,7 +4,10 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-pub(super) const SCALES: [u32; 4] = [8, 4, 2, 1];
+/// The passes' scales, coarsest first. The first is 16×: on a large mesh the first image's
+/// time is mostly its sparse rays walking a cold tree (the dragon's 8× pass: 6,900 rays, 80%
+/// of its time), and 16× traces a quarter of them (docs/perf.md).
+pub(super) const SCALES: [u32; 5] = [16, 8, 4, 2, 1];
 
 /// After a coarse pass, the render goes straight to the full-resolution pass when the rays
 /// that pass has left would take less than this at the coarse pass's time per ray. That time
@@ -31,12 +34,12 @@ pub enum Tracing {
 /// Which passes a render makes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Passes {
-    /// Coarse passes (one ray per 8×8 block, 4×4, 2×2) then every pixel; straight to the
-    /// full pass when the first is quick.
+    /// Coarse passes (one ray per 16×16 block, 8×8, 4×4, 2×2) then every pixel; straight to
+    /// the full pass when a coarse one is quick.
     #[default]
     Progressive,
-    /// Only the first two coarse passes: what the editor renders while the mouse drags the
-    /// view, refining once it stops.
+    /// Only the first three coarse passes (down to 4×4): what the editor renders while the
+    /// mouse drags the view, refining once it stops.
     Coarse,
     /// One full-resolution pass.
     Full,
@@ -71,7 +74,7 @@ impl RenderPlan {
     pub(super) fn schedule(&self) -> Schedule<'static> {
         let (scales, straight_to_full_below): (&[u32], _) = match self.passes {
             Passes::Progressive => (&SCALES, Some(STRAIGHT_TO_FULL_BELOW)),
-            Passes::Coarse => (&SCALES[..2], None),
+            Passes::Coarse => (&SCALES[..3], None),
             Passes::Full => (&[1], None),
         };
         Schedule {

@@ -1,94 +1,31 @@
 //! The progressive, cancellable renderer. A render runs in passes from coarse (one ray per
-//! 8×8 block) to full resolution; each pass traces only the pixels no earlier pass traced,
+//! 16×16 block) to full resolution; each pass traces only the pixels no earlier pass traced,
 //! so the last pass leaves exactly the image a single full pass would. The passes between a
 //! coarse pass and the full one are left out when that coarse pass shows the full image will
-//! come quickly. Tiles are rendered in parallel with rayon and copied into a shared frame
-//! that another thread may read at any time: tile by tile in the fine passes, a whole pass
-//! at once in the coarse ones (cheap to trace, dear to write); a cancel flag stops the work
-//! within one tile.
+//! come quickly. Tiles are rendered in parallel with rayon into a shared frame that another
+//! thread may read at any time: tile by tile in the fine passes; in the coarse ones (cheap to
+//! trace, dear to write) a whole pass at once, kept at its own resolution until the frame is
+//! read or a fine pass needs it. A cancel flag stops the work within one tile.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
 use super::camera::PixelRays;
+use super::coarse::CoarseFrame;
 use super::compile::CompiledScene;
 use super::cull::TileCull;
 use super::frame::{Frame, Sample, write_sample};
 use super::plan::{Cancel, RenderPlan, Schedule, Tracing, Uncancellable};
 use super::shade::shade_fast;
 use super::shade_lanes::shade_packet;
+use super::shared_frame::SharedFrame;
 use super::whitted::{needs_whitted, shade_primary};
 use super::{ObjectRays, RenderSettings};
 use crate::geometry::Ray;
 
 const TILE: u32 = 64;
-
-/// A frame being filled by a render and read by others (the GUI) while it fills.
-#[derive(Debug)]
-pub struct SharedFrame {
-    frame: Mutex<Frame>,
-    /// Bumped whenever pixels change, so readers copy only when there is something new.
-    version: AtomicU64,
-    /// Tiles finished and tiles planned in the current render, over all passes.
-    tiles_done: AtomicU64,
-    tiles_total: AtomicU64,
-}
-
-impl Default for SharedFrame {
-    fn default() -> Self {
-        SharedFrame {
-            frame: Mutex::new(Frame::new(0, 0)),
-            version: AtomicU64::new(0),
-            tiles_done: AtomicU64::new(0),
-            tiles_total: AtomicU64::new(0),
-        }
-    }
-}
-
-impl SharedFrame {
-    pub fn new() -> Self {
-        Self::default()
-    }
-    /// A `width` × `height` frame allocated now, fallibly: a render of that size into it
-    /// allocates no frame of its own.
-    pub fn try_sized(width: u32, height: u32) -> Result<Self, crate::memory::OutOfMemory> {
-        let shared = Self::new();
-        *shared.lock() = Frame::try_new(width, height)?;
-        Ok(shared)
-    }
-    /// The frame as it is now. Hold the guard briefly: the renderer waits for it.
-    pub fn lock(&self) -> MutexGuard<'_, Frame> {
-        self.frame.lock().unwrap_or_else(PoisonError::into_inner)
-    }
-    /// The frame, leaving an empty one: a finished render's image as a value.
-    pub fn take(&self) -> Frame {
-        std::mem::replace(&mut *self.lock(), Frame::new(0, 0))
-    }
-    /// Puts a whole finished image in place (one not rendered by passes, such as
-    /// `-visualize_grid`'s), so readers see it as new.
-    pub fn set(&self, frame: Frame) {
-        *self.lock() = frame;
-        self.bump();
-    }
-    pub fn version(&self) -> u64 {
-        self.version.load(Ordering::Acquire)
-    }
-    /// Fraction of the current render's work done, in [0, 1].
-    pub fn progress(&self) -> f32 {
-        let total = self.tiles_total.load(Ordering::Relaxed);
-        if total == 0 {
-            0.0
-        } else {
-            self.tiles_done.load(Ordering::Relaxed) as f32 / total as f32
-        }
-    }
-    fn bump(&self) {
-        self.version.fetch_add(1, Ordering::AcqRel);
-    }
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassInfo {
@@ -97,7 +34,7 @@ pub struct PassInfo {
     /// Passes this render makes: fewer from a quick coarse pass on, which skips the passes
     /// between it and the full one.
     pub passes: usize,
-    /// Pixels per traced sample along each axis in this pass (8, 4, 2, then 1).
+    /// Pixels per traced sample along each axis in this pass (16, 8, 4, 2, then 1).
     pub scale: u32,
     /// Time since the render started.
     pub elapsed: Duration,
@@ -393,15 +330,60 @@ fn trace_tile(
     grid
 }
 
-/// Passes this coarse or coarser are traced whole and then written in one go, the bands of
-/// tile rows in parallel: their rays are few, and written tile by tile under the frame's lock
-/// the blocks' copies (the whole frame, for a sixteenth of the rays or less) kept all but one
-/// thread waiting (docs/perf.md).
+/// Passes this coarse or coarser are traced whole and kept at their own resolution
+/// ([`CoarseFrame`], spread over the frame when it is read): their rays are few, and written
+/// tile by tile under the frame's lock the blocks' copies (the whole frame, for a sixteenth of
+/// the rays or less) kept all but one thread waiting (docs/perf.md).
 const WRITE_WHOLE_FROM_SCALE: u32 = 4;
+
+/// A whole pass's tile grids as one grid over the frame (the points traced before unset).
+fn gather(traced: &[(TilePass, Vec<Sample>)], w: u32, h: u32, scale: u32) -> CoarseFrame {
+    let gw = w.div_ceil(scale) as usize;
+    let mut samples = vec![Sample::UNSET; gw * h.div_ceil(scale) as usize];
+    for (tp, grid) in traced {
+        // Tile corners are multiples of every scale.
+        let (i0, j0) = ((tp.x0 / scale) as usize, (tp.y0 / scale) as usize);
+        for (j, row) in grid.chunks(tp.gw as usize).enumerate() {
+            let at = (j0 + j) * gw + i0;
+            samples[at..at + row.len()].copy_from_slice(row);
+        }
+    }
+    CoarseFrame {
+        width: w,
+        height: h,
+        scale,
+        samples,
+    }
+}
+
+/// The points of `grid` the pass at scale `coarser` traced (every ratio-th of this grid),
+/// from that pass: kept coarse, or spread over the frame since.
+fn fill_traced_before(grid: &mut CoarseFrame, coarser: u32, p: &super::shared_frame::Pixels) {
+    let ratio = (coarser / grid.scale) as usize;
+    let (gw, gh) = (grid.grid_width() as usize, grid.grid_height() as usize);
+    for j in (0..gh).step_by(ratio) {
+        for i in (0..gw).step_by(ratio) {
+            let (x, y) = ((i as u32) * grid.scale, (j as u32) * grid.scale);
+            let before = match &p.coarse {
+                Some(c) => c.get(x, y),
+                None => p.frame.get(x, y),
+            };
+            // Always there: the coarser pass covered this frame (a reader spreads it whole).
+            if let Some(&s) = before {
+                grid.samples[j * gw + i] = s;
+            }
+        }
+    }
+}
 
 /// Passes this coarse or coarser let an incoherent packet go one ray at a time
 /// (`intersect8_with`); in the finer passes the test misjudged packets that were paying.
 const SPARSE_FROM_SCALE: u32 = 4;
+
+/// Passes this fine or finer may skip to the full pass. A 16× pass does not: its few rays
+/// leave the tree cold for the full pass, which then took longer than the 8× pass it skipped
+/// (the dragon's full image 19.4 → 21.5 ms, docs/perf.md).
+const SKIP_FROM_SCALE: u32 = 8;
 
 /// How many passes to skip after pass `pass` of `plan`, which took `took`: those between it
 /// and the full-resolution pass that ends the plan, when the full pass's rays would take
@@ -413,7 +395,9 @@ fn passes_to_skip(
     (w, h): (u32, u32),
     below: Option<Duration>,
 ) -> usize {
-    let Some(below) = below else { return 0 };
+    let Some(below) = below.filter(|_| plan[pass] <= SKIP_FROM_SCALE) else {
+        return 0;
+    };
     let between = plan.len().saturating_sub(pass + 2);
     if between == 0 || plan.last() != Some(&1) {
         return 0;
@@ -446,9 +430,7 @@ fn render_scales<C: Cancel>(
     let (w, h) = (settings.width, settings.height);
     if settings.variant.is_some() {
         // A mistake's picture (diff's diagnosis): one plain pass, nothing of the fast path.
-        let frame = super::mistakes::render_variant(scene, settings);
-        *target.lock() = frame;
-        target.bump();
+        target.set(super::mistakes::render_variant(scene, settings));
         on_pass(PassInfo {
             pass: 0,
             passes: 1,
@@ -458,9 +440,13 @@ fn render_scales<C: Cancel>(
         return Ok(());
     }
     {
-        let mut f = target.lock();
-        if f.width != w || f.height != h {
-            *f = Frame::new(w, h);
+        let mut p = target.pixels();
+        p.coarse = None;
+        // A first pass kept coarse leaves the frame to be sized when it is spread (the editor
+        // renders into fresh frames: 10 MB less to allocate and fill before the first image).
+        let kept_coarse = scales.first().is_some_and(|&s| s >= WRITE_WHOLE_FROM_SCALE);
+        if (p.frame.width != w || p.frame.height != h) && !(kept_coarse && w > 0 && h > 0) {
+            p.frame = Frame::new(w, h);
         }
     }
     target.bump();
@@ -512,30 +498,27 @@ fn render_scales<C: Cancel>(
                     Ok((tp, grid))
                 })
                 .collect::<Result<_, _>>()?;
-            let mut bands: Vec<Vec<(TilePass, Vec<Sample>)>> =
-                (0..tiles_y).map(|_| Vec::new()).collect();
-            for (tp, grid) in traced {
-                bands[(tp.y0 / TILE) as usize].push((tp, grid));
+            let mut grid = gather(&traced, w, h, scale);
+            let mut p = target.pixels();
+            if let Some(coarser) = coarser {
+                fill_traced_before(&mut grid, coarser, &p);
             }
-            // Held across the parallel write (about 1 ms at 800², longer for larger frames; a
-            // reader waits that long). No job under it locks this frame, nor can a stolen one:
-            // a render's tile-by-tile passes never overlap its whole-pass writes, and two
-            // renders never share a frame at once (the editor gives each render fresh ones).
-            let mut f = target.lock();
-            let band_len = (w * TILE) as usize;
-            f.samples
-                .par_chunks_mut(band_len)
-                .zip(bands.par_iter_mut())
-                .enumerate()
-                .for_each(|(b, (band, tiles))| {
-                    let mut line = Vec::with_capacity(TILE as usize);
-                    for (tp, grid) in tiles {
-                        write_tile(band, w as usize, b as u32 * TILE, tp, grid, &mut line);
-                    }
-                });
-            drop(f);
+            p.coarse = Some(grid);
+            drop(p);
             target.bump();
         } else {
+            if let Some(stop) = cancel.stop() {
+                return Err(stop);
+            }
+            {
+                // The tiles read the coarser pass's points back from the frame. Spread under
+                // the lock, in parallel: no job under it locks this frame, nor can a stolen one
+                // (this render's tiles start after it; two renders never share a frame).
+                let mut p = target.pixels();
+                if let Some(c) = p.coarse.take() {
+                    c.spread_into(&mut p.frame, true);
+                }
+            }
             tiles.par_iter().try_for_each(|t| {
                 if let Some(stop) = cancel.stop() {
                     return Err(stop);
@@ -643,8 +626,8 @@ mod tests {
             for tracing in [Tracing::Packets, Tracing::SingleRays] {
                 // (plan, bound, the passes shown, PassInfo::passes after each)
                 let plans: [(&[u32], _, &[u32], &[usize]); 3] = [
-                    (&SCALES, None, &SCALES, &[4, 4, 4, 4]),
-                    (&SCALES, Some(Duration::MAX), &[8, 1], &[2, 2]),
+                    (&SCALES, None, &SCALES, &[5, 5, 5, 5, 5]),
+                    (&SCALES, Some(Duration::MAX), &[16, 8, 1], &[5, 3, 3]),
                     (&[8, 4, 1], None, &[8, 4, 1], &[3, 3, 3]),
                 ];
                 for (plan, skip, scales, passes) in plans {
@@ -679,32 +662,92 @@ mod tests {
         }
     }
 
+    /// Coarse passes nobody reads stay at their own resolution, each taking the points of the
+    /// one before from that one's grid: what `coarse()` shows after each, unread, is the
+    /// blocks of the full render, the frame is untouched (a fresh frame stays unsized until
+    /// read), and the full pass then starts from them and ends with the full render.
+    #[test]
+    fn unread_coarse_passes_chain_at_their_own_resolution() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/nested_transforms.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
+        let c = CompiledScene::new(&scene);
+        for (w, h) in [(150u32, 97u32), (7, 130)] {
+            let s = RenderSettings::new(w, h);
+            let full = render_frame(&c, &s);
+            let target = SharedFrame::new();
+            let mut shown = Vec::new();
+            let schedule = Schedule {
+                scales: &SCALES,
+                straight_to_full_below: None,
+                tracing: Tracing::Packets,
+            };
+            let Ok(()) = render_scales(&c, &s, schedule, &target, &Uncancellable, &mut |p| {
+                let coarse = target.coarse();
+                // What readers that do not lock see: the pass shown, at the frame's size.
+                let now = target.shown();
+                assert_eq!(now.size(), (w, h));
+                for (x, y) in [(0, 0), (w - 1, h - 1), (w / 2, h / 3), (w, 0), (0, h)] {
+                    let want = match &coarse {
+                        Some(c) => c.get(x, y),
+                        None => now.0.frame.get(x, y),
+                    };
+                    assert_eq!(now.get(x, y), want);
+                }
+                drop(now);
+                shown.push((p.scale, coarse, target.pixels().frame.width));
+            });
+            for (scale, coarse, frame_width) in &shown {
+                if *scale < WRITE_WHOLE_FROM_SCALE {
+                    assert!(coarse.is_none(), "{scale}× is written into the frame");
+                    continue;
+                }
+                let coarse = coarse.as_ref().expect("kept coarse");
+                assert_eq!((coarse.scale, *frame_width), (*scale, 0), "{w}x{h}");
+                let f = coarse.spread();
+                for y in 0..h {
+                    for x in 0..w {
+                        let corner = full.get(x - x % scale, y - y % scale);
+                        assert_eq!(f.get(x, y), corner, "{w}x{h} {scale}× ({x}, {y})");
+                    }
+                }
+            }
+            assert_eq!(*target.lock(), full, "{w}x{h}");
+        }
+    }
+
     /// A coarse pass skips the passes between it and the full one when the full pass's rays
-    /// would take less than the bound at its time per ray. At 800², the 8× pass traces 10,000
-    /// rays and leaves 630,000 (250 ms allows 3.97 ms); the 4× pass traces 30,000 and leaves
-    /// 600,000 (12.5 ms).
+    /// would take less than the bound at its time per ray, the 16× pass never. At 800², the
+    /// 8× pass traces 7,500 rays after the 16× one and leaves 630,000 (250 ms allows 2.98 ms);
+    /// the 4× pass traces 30,000 and leaves 600,000 (12.5 ms).
     #[test]
     fn a_quick_coarse_pass_goes_straight_to_the_full_one() {
         let ms = Duration::from_millis;
         let us = Duration::from_micros;
         let below = Some(STRAIGHT_TO_FULL_BELOW);
         assert_eq!(STRAIGHT_TO_FULL_BELOW, ms(250));
+        assert_eq!(SCALES, [16, 8, 4, 2, 1]);
         let skip = |plan: &[u32], pass, took, size| passes_to_skip(plan, pass, took, size, below);
-        assert_eq!(skip(&SCALES, 0, us(3_950), (800, 800)), 2);
-        assert_eq!(skip(&SCALES, 0, us(4_000), (800, 800)), 0);
-        assert_eq!(skip(&SCALES, 1, ms(12), (800, 800)), 1);
-        assert_eq!(skip(&SCALES, 1, ms(13), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 0, Duration::ZERO, (800, 800)), 0, "16× never");
+        assert_eq!(skip(&[16, 1], 0, Duration::ZERO, (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 1, us(2_950), (800, 800)), 2);
+        assert_eq!(skip(&SCALES, 1, us(3_000), (800, 800)), 0);
+        assert_eq!(skip(&SCALES, 2, ms(12), (800, 800)), 1);
+        assert_eq!(skip(&SCALES, 2, ms(13), (800, 800)), 0);
         // Any size leaves about the same multiple of a pass's rays: the time per ray decides.
-        assert_eq!(skip(&SCALES, 1, ms(12), (3840, 2160)), 1);
-        assert_eq!(skip(&SCALES, 1, ms(13), (3840, 2160)), 0);
+        assert_eq!(skip(&SCALES, 2, ms(12), (3840, 2160)), 1);
+        assert_eq!(skip(&SCALES, 2, ms(13), (3840, 2160)), 0);
         assert_eq!(passes_to_skip(&SCALES, 0, ms(1), (800, 800), None), 0);
         assert_eq!(
-            skip(&SCALES, 2, ms(1), (800, 800)),
+            skip(&SCALES, 3, ms(1), (800, 800)),
             0,
             "nothing between 2× and 1×"
         );
         assert_eq!(
-            skip(&SCALES[..2], 0, ms(1), (800, 800)),
+            skip(&SCALES[..3], 1, us(1), (800, 800)),
             0,
             "the coarse passes alone"
         );

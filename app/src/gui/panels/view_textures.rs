@@ -99,7 +99,13 @@ impl ViewTextures {
             Some(Selection::Node(id)) => overlays::subtree_ids(&doc.scene, id),
             _ => Default::default(),
         };
-        let image = overlays::outline(&frame.lock(), &ids);
+        // Nothing selected: no outline, and no read that would spread a coarse pass over the
+        // full frame on this thread.
+        let image = if ids.contains(&true) {
+            overlays::outline(&frame.lock(), &ids)
+        } else {
+            None
+        };
         self.outline = image.map(|img| match self.outline.take() {
             Some(mut t) => {
                 t.set(img, egui::TextureOptions::NEAREST);
@@ -136,9 +142,14 @@ impl ViewTextures {
             if self.uploaded[i] == key {
                 continue;
             }
-            let (w, h, rgba) = {
-                let f = frame.lock();
-                (f.width, f.height, f.rgba8(view, s.depth))
+            // A coarse pass not yet spread over the frame is shown from its own grid: the
+            // same bytes, without the renderer or this thread writing the full frame first.
+            let (w, h, rgba) = match frame.coarse() {
+                Some(c) => (c.width, c.height, c.rgba8(view, s.depth)),
+                None => {
+                    let f = frame.lock();
+                    (f.width, f.height, f.rgba8(view, s.depth))
+                }
             };
             if w == 0 || h == 0 {
                 continue;
@@ -186,6 +197,96 @@ impl ViewTextures {
                     p.job.submitted.elapsed().as_secs_f64() * 1e3,
                     ctx.input(|i| i.unstable_dt) * 1e3
                 );
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use tracelab_core::render::{RenderPlan, render, render_frame};
+    use tracelab_core::{CompiledScene, NormalTransform, RenderSettings, SharedFrame};
+
+    use super::*;
+    use crate::gui::panels::view_settings::Tab;
+    use crate::render_worker::Job;
+
+    /// After the first (16×) pass, kept at its own resolution, the view shows in every view
+    /// exactly the bytes it showed when that pass was written into the full frame: each pixel
+    /// its block's corner pixel of the full render. And showing it spreads nothing.
+    #[test]
+    fn a_coarse_pass_is_shown_as_its_blocks_of_the_full_render() {
+        let out = tracelab_core::parse_scene(
+            crate::DEFAULT_SCENE.as_bytes(),
+            "default",
+            None,
+            &mut tracelab_core::MeshCache::new(),
+        );
+        let scene = Arc::new(out.scene.expect("built-in scene parses"));
+        let compiled = Arc::new(CompiledScene::new(&scene));
+        // Partial blocks at the right and bottom edges.
+        let settings = RenderSettings::new(150, 97);
+        let frame = Arc::new(SharedFrame::new());
+        let stop = AtomicBool::new(false);
+        let mut scales = Vec::new();
+        let _ = render(
+            &compiled,
+            &settings,
+            RenderPlan::PROGRESSIVE,
+            &frame,
+            &stop,
+            |p| {
+                scales.push(p.scale);
+                stop.store(true, Ordering::Relaxed);
+            },
+        );
+        assert_eq!(scales, [16]);
+        assert!(frame.coarse().is_some(), "the 16× pass is kept coarse");
+        let p = Published {
+            job: Job {
+                generation: 1,
+                request: 1,
+                scene: scene.clone(),
+                settings,
+                modes: vec![NormalTransform::Correct],
+                submitted: std::time::Instant::now(),
+                coarse: false,
+                grid: None,
+            },
+            compiled: compiled.clone(),
+            frames: vec![frame.clone()],
+            passes_done: 1,
+            passes: 5,
+            first_image: None,
+            full: None,
+            normal_gap: None,
+            grid_error: None,
+        };
+        let s = ViewSettings {
+            tab: Tab::All,
+            ..ViewSettings::default()
+        };
+        let mut textures = ViewTextures::default();
+        textures.upload(&egui::Context::default(), &p, &s);
+        assert!(frame.coarse().is_some(), "shown without spreading it");
+        assert_eq!(textures.shown_size, (150, 97));
+        let full = render_frame(&compiled, &settings);
+        let written = frame.lock().clone();
+        for view in [View::Color, View::Normals, View::Depth] {
+            let shown = textures.image(index(0, view)).expect("uploaded");
+            let before =
+                egui::ColorImage::from_rgba_unmultiplied([150, 97], &written.rgba8(view, s.depth));
+            assert_eq!(*shown, before, "{view:?}");
+            for y in 0..97 {
+                for x in 0..150 {
+                    let corner = full.get(x - x % 16, y - y % 16).expect("in the frame");
+                    let [r, g, b] = corner.rgb8(view, s.depth);
+                    let px = shown.pixels[(y * 150 + x) as usize];
+                    assert_eq!([px.r(), px.g(), px.b()], [r, g, b], "{view:?} ({x}, {y})");
+                }
             }
         }
     }

@@ -352,8 +352,10 @@ fn shows_object(worker: &RenderWorker, frame: usize, image: egui::Rect, r: egui:
         let Some(f) = p.and_then(|p| p.frames.get(frame)) else {
             return false;
         };
-        let f = f.lock();
-        let (w, h) = (f.width as f32, f.height as f32);
+        // As shown: a lock would spread a coarse pass over the full frame.
+        let f = f.shown();
+        let (w, h) = f.size();
+        let (w, h) = (w as f32, h as f32);
         let to_px = |q: egui::Pos2| ((q - image.min) / image.size()) * egui::vec2(w, h);
         let (a, b) = (to_px(r.min), to_px(r.max));
         let xs = (a.x.floor().max(0.0) as u32)..(b.x.ceil().min(w) as u32);
@@ -391,7 +393,7 @@ fn split_halves(rect: egui::Rect, line: SplitLine, at: f32) -> (egui::Rect, egui
 fn surface_point(worker: &RenderWorker, frame: usize, px: glam::Vec2) -> Option<glam::Vec3> {
     worker.with_published(|p| {
         let p = p?;
-        let f = p.frames.get(frame)?.lock();
+        let f = p.frames.get(frame)?.shown();
         if px.x < 0.0 || px.y < 0.0 {
             return None;
         }
@@ -400,7 +402,8 @@ fn surface_point(worker: &RenderWorker, frame: usize, px: glam::Vec2) -> Option<
         if !t.is_finite() {
             return None;
         }
-        let ray = p.compiled.camera.pixel_ray(x, row, f.width, f.height);
+        let (w, h) = f.size();
+        let ray = p.compiled.camera.pixel_ray(x, row, w, h);
         Some(ray.origin + ray.direction * t)
     })
 }
