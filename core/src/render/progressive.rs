@@ -601,6 +601,17 @@ mod tests {
     use crate::{MeshCache, load_scene};
     use std::sync::atomic::AtomicBool;
 
+    /// scenes/nested_transforms.txt, compiled.
+    fn nested_transforms() -> CompiledScene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/nested_transforms.txt");
+        let scene = load_scene(&path, &mut MeshCache::new())
+            .into_result()
+            .expect("scene loads")
+            .0;
+        CompiledScene::new(&scene)
+    }
+
     /// What the viewport shows after each pass: every pixel holds the sample of its block's
     /// corner pixel in that pass's grid (multiples of the scale), which the full-resolution
     /// render traced too. Sizes with partial tiles and partial blocks, both the coarse passes
@@ -609,13 +620,7 @@ mod tests {
     /// grid), or a full pass after the 4× one.
     #[test]
     fn each_pass_shows_its_blocks_of_the_full_render() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenes/nested_transforms.txt");
-        let scene = load_scene(&path, &mut MeshCache::new())
-            .into_result()
-            .expect("scene loads")
-            .0;
-        let c = CompiledScene::new(&scene);
+        let c = nested_transforms();
         for (w, h) in [(150u32, 97u32), (64, 64), (7, 130)] {
             let s = RenderSettings::new(w, h);
             let full = render_frame(&c, &s);
@@ -668,13 +673,7 @@ mod tests {
     /// read), and the full pass then starts from them and ends with the full render.
     #[test]
     fn unread_coarse_passes_chain_at_their_own_resolution() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenes/nested_transforms.txt");
-        let scene = load_scene(&path, &mut MeshCache::new())
-            .into_result()
-            .expect("scene loads")
-            .0;
-        let c = CompiledScene::new(&scene);
+        let c = nested_transforms();
         for (w, h) in [(150u32, 97u32), (7, 130)] {
             let s = RenderSettings::new(w, h);
             let full = render_frame(&c, &s);
