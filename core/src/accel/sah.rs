@@ -30,7 +30,7 @@ pub struct LeafBlock(pub u32);
 
 impl LeafBlock {
     #[inline]
-    fn cost(self, n: u32) -> f32 {
+    pub(super) fn cost(self, n: u32) -> f32 {
         n.div_ceil(self.0.max(1)) as f32
     }
 }

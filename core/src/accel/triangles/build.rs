@@ -38,7 +38,7 @@ impl TriangleBvh {
         let Some(root) = sah::build(&mut prims, block) else {
             return TriangleBvh::default();
         };
-        let nodes = wide::collapse(&root);
+        let nodes = wide::collapse(&root, block);
         // The temporary tree is freed on another thread while the triangles are copied.
         let ((tris, ids), ()): ((Vec<Tri>, Vec<u32>), ()) = rayon::join(
             || {
