@@ -13,10 +13,10 @@ use crate::accel::wide::WIDTH;
 
 /// `avx::leaf8` with AVX-512VL mask registers: the same eight lanes, the same operations in
 /// the same order (no FMA), the tests' results in mask registers instead of blends, so t is
-/// bit for bit `leaf8`'s.
+/// bit for bit `leaf8`'s. `CALLER`: one copy per call site, as for `avx::leaf8`.
 #[target_feature(enable = "avx512f,avx512vl")]
 #[inline]
-pub(super) fn leaf8<L: avx::LeafRay>(
+pub(super) fn leaf8<L: avx::LeafRay, const CALLER: u8>(
     bvh: &TriangleBvh,
     ray: &L,
     first: usize,

@@ -164,9 +164,14 @@ impl TriangleBvh {
                 while rays != 0 {
                     let i = rays.trailing_zeros() as usize;
                     rays &= rays - 1;
-                    if let Some((t, k)) =
-                        avx::leaf8(self, &(o[i], d[i]), first, count, t_min, t_best[i])
-                    {
+                    if let Some((t, k)) = avx::leaf8::<_, { avx::caller::PACKET }>(
+                        self,
+                        &(o[i], d[i]),
+                        first,
+                        count,
+                        t_min,
+                        t_best[i],
+                    ) {
                         t_best[i] = t;
                         best[i] = k;
                         hit = true;

@@ -4,7 +4,7 @@
 use glam::{Vec3A, Vec4};
 
 #[cfg(target_arch = "x86_64")]
-use super::avx::{self, LeafRay};
+use super::avx::{self, LeafRay, caller};
 #[cfg(target_arch = "x86_64")]
 use super::avx512;
 use super::{SLAB_WIDEN, TriangleBvh, TriangleHit, finite_ray, has_avx, has_avx512};
@@ -264,7 +264,9 @@ impl TriangleBvh {
             |r, n, t_min, t_max, t_enter| {
                 avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
-            |r, first, count, t_min, t_best| avx::leaf8(self, r, first, count, t_min, t_best),
+            |r, first, count, t_min, t_best| {
+                avx::leaf8::<_, { caller::CLOSEST }>(self, r, first, count, t_min, t_best)
+            },
         )
     }
 
@@ -289,7 +291,9 @@ impl TriangleBvh {
             |r, n, t_min, t_max, t_enter| {
                 avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
-            |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
+            |r, first, count, t_min, t_best| {
+                avx512::leaf8::<_, { caller::CLOSEST }>(self, r, first, count, t_min, t_best)
+            },
         )
     }
 
@@ -343,7 +347,9 @@ impl TriangleBvh {
             |r, n, t_min, t_max, t_enter| {
                 avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
-            |r, first, count, t_min, t_best| avx::leaf8(self, r, first, count, t_min, t_best),
+            |r, first, count, t_min, t_best| {
+                avx::leaf8::<_, { caller::ANY }>(self, r, first, count, t_min, t_best)
+            },
         )
         .is_some()
     }
@@ -360,7 +366,9 @@ impl TriangleBvh {
             |r, n, t_min, t_max, t_enter| {
                 avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
             },
-            |r, first, count, t_min, t_best| avx512::leaf8(self, r, first, count, t_min, t_best),
+            |r, first, count, t_min, t_best| {
+                avx512::leaf8::<_, { caller::ANY }>(self, r, first, count, t_min, t_best)
+            },
         )
         .is_some()
     }
