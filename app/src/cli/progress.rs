@@ -87,7 +87,10 @@ pub(super) struct Watcher {
 
 impl Watcher {
     pub fn on_stderr(template: &str, len: u64, done: impl Fn() -> u64 + Send + 'static) -> Self {
-        let mut bar = Progress::on_stderr(template, len);
+        Watcher::drawing(Progress::on_stderr(template, len), len, done)
+    }
+
+    fn drawing(mut bar: Progress, len: u64, done: impl Fn() -> u64 + Send + 'static) -> Self {
         let stop = Arc::new(AtomicBool::new(false));
         let thread = bar.on_terminal().then(|| {
             let stop = stop.clone();
@@ -103,7 +106,16 @@ impl Watcher {
     }
 
     /// The work is done: the bar (if shown) is finished before this returns.
-    pub fn finish(mut self) {
+    pub fn finish(self) {
+        drop(self);
+    }
+}
+
+/// Also when the work ends early (an error returned with `?`, a panic unwinding): the
+/// thread is stopped and the bar finished, rather than left redrawing until the process
+/// exits.
+impl Drop for Watcher {
+    fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
             let _ = t.join();
@@ -183,6 +195,42 @@ mod tests {
         let text = screen.text();
         assert!(text.contains("rendering ["), "{text:?}");
         assert!(text.contains("100%"), "{text:?}");
+    }
+
+    #[test]
+    fn a_watcher_dropped_without_finish_stops_its_thread_and_finishes_the_bar() {
+        use std::sync::atomic::AtomicU64;
+        let (bar, screen) = on_screen(Duration::ZERO);
+        let calls = Arc::new(AtomicU64::new(0));
+        let counted = calls.clone();
+        let watcher = Watcher::drawing(bar, 100, move || {
+            counted.fetch_add(1, Ordering::Relaxed);
+            50
+        });
+        // Control: the thread runs while the watcher lives.
+        let start = Instant::now();
+        while calls.load(Ordering::Relaxed) == 0 && start.elapsed() < Duration::from_secs(10) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        assert!(
+            calls.load(Ordering::Relaxed) > 0,
+            "the bar's thread never ran"
+        );
+        // Work that ends with an error instead of calling `finish`.
+        let early: Result<(), &str> = (|| {
+            let _w = watcher;
+            Err("the render failed")
+        })();
+        assert!(early.is_err());
+        // Dropped means joined: no call can follow (one every 100 ms while it ran).
+        let after = calls.load(Ordering::Relaxed);
+        std::thread::sleep(Duration::from_millis(500));
+        assert_eq!(
+            calls.load(Ordering::Relaxed),
+            after,
+            "the thread still runs"
+        );
+        assert!(screen.text().contains("100%"), "{:?}", screen.text());
     }
 
     #[test]
