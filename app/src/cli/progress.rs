@@ -217,11 +217,10 @@ mod tests {
             "the bar's thread never ran"
         );
         // Work that ends with an error instead of calling `finish`.
-        let early: Result<(), &str> = (|| {
-            let _w = watcher;
+        fn fails_early(_w: Watcher) -> Result<(), &'static str> {
             Err("the render failed")
-        })();
-        assert!(early.is_err());
+        }
+        assert!(fails_early(watcher).is_err());
         // Dropped means joined: no call can follow (one every 100 ms while it ran).
         let after = calls.load(Ordering::Relaxed);
         std::thread::sleep(Duration::from_millis(500));
