@@ -474,3 +474,89 @@ fn pictures_of_an_image_over_a_million_pixels_are_not_inlined() {
     assert!(html.contains("pictures not inlined: 1025×1024 is over 1048576 pixels"));
     assert!(!html.contains("data:image/png"));
 }
+
+/// `tracelab diff --batch … | head -0`: the reader is gone before the summary is printed.
+/// The summary is lost, not the verdict (found by the 1,000,000-case command-line fuzz run:
+/// the broken pipe ended the run with exit 0 before the verdict and the report's failure).
+#[test]
+fn a_reader_gone_drops_the_summary_but_not_the_verdict() {
+    let d = class("reader-gone", &[line(1)]);
+    images(&d, 1, Some(Variant::one(Mistake::PixelCorners)));
+    let run = |report: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+            .args(["diff", "--batch", "commands.txt", "--images", "images"])
+            .args(["--report", report])
+            .current_dir(&d)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run tracelab");
+        drop(child.stdout.take());
+        child.wait_with_output().expect("wait")
+    };
+    // Control: with its reader there, the line's mistake gives exit 3.
+    let o = batch(&d, &["--report", "r.html"]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
+    let o = run("r2.html");
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
+    assert!(d.join("r2.html").is_file(), "the report is still written");
+}
+
+/// The fuzz run's case: the report on a full device and no reader for the summary. The
+/// report's failure is the exit code (1), not the quiet end of a broken pipe (0).
+#[cfg(unix)]
+#[test]
+#[ignore = "needs root: makes a private device node (mknod)"]
+fn a_report_that_cannot_be_written_is_an_error_with_no_reader_either() {
+    let d = class("reader-gone-full", &[line(1)]);
+    images(&d, 1, None);
+    common::mknod(&d, "full.html", 7);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(["diff", "--batch", "commands.txt", "--images", "images"])
+        .args(["--report", "full.html"])
+        .current_dir(&d)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run tracelab");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("wait");
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("cannot write the report"),
+        "{}",
+        text(&o.stderr)
+    );
+}
+
+/// The same for one image: `tracelab diff … | head` on an image that differs exits 3.
+#[test]
+fn a_reader_gone_keeps_a_single_diffs_verdict() {
+    let d = class("reader-gone-single", &[line(1)]);
+    images(&d, 1, Some(Variant::one(Mistake::PixelCorners)));
+    let args = [
+        "diff",
+        "images/out1.png",
+        "--",
+        "-input",
+        "scenes/s.txt",
+        "-size",
+        "60",
+        "60",
+        "-output",
+        "images/out1.png",
+    ];
+    // Control: read to the end, it differs.
+    let o = tracelab(&args, &d);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(&d)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run tracelab");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("wait");
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
+}

@@ -339,20 +339,6 @@ fn fmt_refuses_to_write_what_it_could_not_read_back() {
 
 // ---- Robustness (issue 11): sizes, non-UTF-8 arguments, pipes, full devices, writes ----
 
-/// A private device node (never the machine's own /dev files); `None`, with a message,
-/// where mknod is not allowed.
-#[cfg(unix)]
-fn mknod(dir: &Path, name: &str, minor: u32) -> PathBuf {
-    let p = dir.join(name);
-    let ok = Command::new("mknod")
-        .arg(&p)
-        .args(["c", "1", &minor.to_string()])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(ok, "mknod {} failed: this test needs root", p.display());
-    p
-}
-
 #[cfg(unix)]
 fn is_char_device(p: &Path) -> bool {
     use std::os::unix::fs::FileTypeExt;
@@ -526,7 +512,7 @@ fn bench_into_a_closed_pipe_ends_quietly() {
 #[ignore = "needs root: makes a private device node (mknod)"]
 fn bench_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("bench-full");
-    let full = mknod(&d, "full", 7);
+    let full = common::mknod(&d, "full", 7);
     let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
         .args([
             "bench",
@@ -560,7 +546,7 @@ fn bench_to_a_full_standard_output_is_an_error() {
 #[ignore = "needs root: makes a private device node (mknod)"]
 fn fmt_to_a_full_standard_output_is_an_error() {
     let d = temp_dir("stdout-full");
-    let full = mknod(&d, "full", 7);
+    let full = common::mknod(&d, "full", 7);
     let scene = big_scene(&d);
     let o = Command::new(env!("CARGO_BIN_EXE_tracelab"))
         .arg("fmt")
@@ -590,7 +576,7 @@ fn writing_to_a_full_device_fails_for_every_output_and_leaves_the_node() {
     let scene = repo().join("scenes/inside_sphere.txt");
     let scene = scene.to_str().expect("utf-8 path");
     for ext in ["png", "tga", "ppm", "bmp"] {
-        let full = mknod(&d, &format!("full.{ext}"), 7);
+        let full = common::mknod(&d, &format!("full.{ext}"), 7);
         let o = tracelab(
             &[
                 "render",
@@ -606,11 +592,11 @@ fn writing_to_a_full_device_fails_for_every_output_and_leaves_the_node() {
         assert_eq!(o.status.code(), Some(1), "{ext}: {}", stderr(&o));
         assert!(is_char_device(&full), "{ext}: still a device node");
     }
-    let full = mknod(&d, "full.txt", 7);
+    let full = common::mknod(&d, "full.txt", 7);
     let o = tracelab(&["fmt", scene, "-o", "full.txt"], &d);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(is_char_device(&full), "fmt -o keeps the device node");
-    let null = mknod(&d, "null.txt", 3);
+    let null = common::mknod(&d, "null.txt", 3);
     let o = tracelab(&["fmt", scene, "-o", "null.txt"], &d);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(is_char_device(&null), "fmt -o writes into a null device");

@@ -13,7 +13,7 @@ use super::judge::{Criterion, count};
 use super::render::RenderJob;
 use super::report_html::{ImageRow, LineRow, Pictures, report_html};
 use crate::exit::{Exit, check_size, usage};
-use crate::io::{OutputPlan, write_atomic, write_implicit, write_stderr_text, write_stdout_text};
+use crate::io::{OutputPlan, write_atomic, write_implicit, write_stderr_text, write_summary_text};
 
 /// The largest commands file read (the handout's is 2 KiB).
 pub const COMMANDS_CAP: u64 = 1 << 20;
@@ -276,7 +276,7 @@ pub fn run_batch(a: &DiffArgs, commands: &Path, c: &Criterion) -> anyhow::Result
             Err(_) => "not written".into(),
         }
     ));
-    write_stdout_text(&summary)?;
+    write_summary_text(&summary)?;
     if let Err(e) = written {
         return Err(anyhow::anyhow!(e));
     }

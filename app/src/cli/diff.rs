@@ -19,7 +19,7 @@ use super::judge::{Criterion, compare, count, difference};
 use super::regions::regions;
 use super::render::{RenderJob, compile_for, frame_for};
 use crate::exit::{Exit, check_size, usage};
-use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_stdout_text};
+use crate::io::{Implicit, OutputPlan, load_scene_and_meshes, write_implicit, write_summary_text};
 use crate::story::{one_line, pixel_report};
 
 /// `tracelab diff --help`.
@@ -612,7 +612,7 @@ pub fn run_diff(a: &DiffArgs) -> anyhow::Result<()> {
     out.push_str(&j.regions);
     let all = j.all_match();
     // Paths and node labels (an `obj_file` name) are the user's text: escaped.
-    write_stdout_text(&out)?;
+    write_summary_text(&out)?;
     if !failed.is_empty() {
         return Err(Exit::HeatMapNotWritten {
             matched: all,

@@ -16,7 +16,10 @@ use tracelab_core::{MeshCache, Scene, Severity};
 pub use atomic::{AtomicFile, write_atomic};
 pub use image::{ImageWriteError, encode_image, image_format, write_image};
 pub use output::{Implicit, OutputError, OutputPlan, write_implicit};
-pub use stdout::{escape_json, escape_text, write_stderr_text, write_stdout, write_stdout_text};
+pub use stdout::{
+    escape_json, escape_text, write_stderr_text, write_stdout, write_stdout_text,
+    write_summary_text,
+};
 
 /// A scene file as read, before it replaces the document: on any thread, so that a large
 /// mesh cannot freeze the window, and before asking about unsaved changes, so that nothing

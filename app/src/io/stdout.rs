@@ -36,6 +36,16 @@ pub fn write_stdout_text(text: &str) -> anyhow::Result<()> {
     write_stdout(escape_text(text).as_bytes())
 }
 
+/// [`write_stdout_text`] for a summary followed by a verdict (`diff`): a reader gone
+/// (`| head`) drops the text, not the verdict, which still sets the exit code (and a side
+/// output's failure still reports itself); a full or failing standard output is an error.
+pub fn write_summary_text(text: &str) -> anyhow::Result<()> {
+    match write_stdout_text(text) {
+        Err(e) if matches!(e.downcast_ref::<Exit>(), Some(Exit::OutputClosed)) => Ok(()),
+        other => other,
+    }
+}
+
 /// Writes a message to standard error with [`escape_text`] applied; with standard error
 /// closed or full there is no one left to tell, so a failure is ignored.
 pub fn write_stderr_text(text: &str) {

@@ -432,10 +432,17 @@ pub fn allowed(case: &Case, case_dir: &Path) -> Allowed {
         let dir = out_dir.unwrap_or_else(|| ".".into());
         // A stem with a folder in it is not a name in --out: nothing it writes is allowed
         // outside the working folder.
+        // A folder that does not exist yet is made (one level), as asked: the folder itself
+        // is an output (the 1,000,000-case run's `--out ../escaped.png`, outside `work`).
+        let d = folder_path(case_dir, &work, &dir).or_else(|| {
+            let d = lexical_path(case_dir, &work, &dir)?;
+            a.outputs.insert(d.clone());
+            Some(d)
+        });
         if !stem.as_bytes().contains(&b'/')
             && stem != "."
             && stem != ".."
-            && let Some(d) = folder_path(case_dir, &work, &dir)
+            && let Some(d) = d
         {
             let lossy = stem.to_string_lossy().into_owned().into_bytes();
             a.implicit.push((d, vec![stem.as_bytes().to_vec(), lossy]));

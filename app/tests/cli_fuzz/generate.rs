@@ -852,7 +852,12 @@ pub fn generate(k: u64, ctx: &Ctx) -> Case {
             loads_meshes = false;
             let g = fmt_groups(&mut rng, ctx);
             let args = line(&["fmt"], g, &mut rng);
-            prints = !args.iter().any(|a| a.role == Role::Output);
+            // `-o` with its value attached (`-object_rays` is `-o bject_rays`) names an
+            // output too (the 1,000,000-case run's case 829517).
+            prints = !args.iter().any(|a| {
+                a.role == Role::Output
+                    || (a.text.as_encoded_bytes().starts_with(b"-o") && a.text.len() > 2)
+            });
             args
         }
         Family::Inspect => {

@@ -1,6 +1,7 @@
 //! A BVH over a mesh's triangles: binned SAH on three axes, built in parallel, collapsed into
-//! 8-wide nodes, with the triangles stored in leaf order as (v0, e1, e2) so a leaf test reads
-//! contiguous memory and skips two subtractions per triangle.
+//! 8-wide nodes by least SAH cost (`wide::collapse`), with the triangles stored in leaf order
+//! as (v0, e1, e2) so a leaf test reads contiguous memory and skips two subtractions per
+//! triangle.
 //!
 //! - `build`: the tree and the triangles' copies in leaf order.
 //! - `check`: the invariants (for tests) and the tree's shape (for `tracelab bench`).
