@@ -20,3 +20,18 @@ pub fn names_in(dir: &Path) -> Vec<String> {
     v.sort();
     v
 }
+
+/// A private device node (character device 1, `minor`: 3 null, 7 full) in `dir`, never the
+/// machine's own /dev files; the test needs root (it fails, saying so, where mknod is
+/// refused). Also the integration tests' (`tests/common` includes this file).
+#[cfg(unix)]
+pub fn mknod(dir: &Path, name: &str, minor: u32) -> PathBuf {
+    let p = dir.join(name);
+    let ok = std::process::Command::new("mknod")
+        .arg(&p)
+        .args(["c", "1", &minor.to_string()])
+        .status()
+        .is_ok_and(|s| s.success());
+    assert!(ok, "mknod {} failed: this test needs root", p.display());
+    p
+}

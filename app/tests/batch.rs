@@ -475,6 +475,20 @@ fn pictures_of_an_image_over_a_million_pixels_are_not_inlined() {
     assert!(!html.contains("data:image/png"));
 }
 
+/// Runs tracelab in `dir` with its standard output a pipe whose reader is gone before the
+/// first write (`| head -0`).
+fn without_reader(args: &[&str], dir: &Path) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run tracelab");
+    drop(child.stdout.take());
+    child.wait_with_output().expect("wait")
+}
+
 /// `tracelab diff --batch … | head -0`: the reader is gone before the summary is printed.
 /// The summary is lost, not the verdict (found by the 1,000,000-case command-line fuzz run:
 /// the broken pipe ended the run with exit 0 before the verdict and the report's failure).
@@ -483,16 +497,18 @@ fn a_reader_gone_drops_the_summary_but_not_the_verdict() {
     let d = class("reader-gone", &[line(1)]);
     images(&d, 1, Some(Variant::one(Mistake::PixelCorners)));
     let run = |report: &str| {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
-            .args(["diff", "--batch", "commands.txt", "--images", "images"])
-            .args(["--report", report])
-            .current_dir(&d)
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .expect("run tracelab");
-        drop(child.stdout.take());
-        child.wait_with_output().expect("wait")
+        without_reader(
+            &[
+                "diff",
+                "--batch",
+                "commands.txt",
+                "--images",
+                "images",
+                "--report",
+                report,
+            ],
+            &d,
+        )
     };
     // Control: with its reader there, the line's mistake gives exit 3.
     let o = batch(&d, &["--report", "r.html"]);
@@ -511,16 +527,8 @@ fn a_report_that_cannot_be_written_is_an_error_with_no_reader_either() {
     let d = class("reader-gone-full", &[line(1)]);
     images(&d, 1, None);
     common::mknod(&d, "full.html", 7);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(["diff", "--batch", "commands.txt", "--images", "images"])
-        .args(["--report", "full.html"])
-        .current_dir(&d)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("run tracelab");
-    drop(child.stdout.take());
-    let o = child.wait_with_output().expect("wait");
+    let args = ["diff", "--batch", "commands.txt", "--images", "images"];
+    let o = without_reader(&[&args[..], &["--report", "full.html"]].concat(), &d);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     assert!(
         text(&o.stderr).contains("cannot write the report"),
@@ -549,14 +557,6 @@ fn a_reader_gone_keeps_a_single_diffs_verdict() {
     // Control: read to the end, it differs.
     let o = tracelab(&args, &d);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
-        .args(args)
-        .current_dir(&d)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("run tracelab");
-    drop(child.stdout.take());
-    let o = child.wait_with_output().expect("wait");
+    let o = without_reader(&args, &d);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
 }

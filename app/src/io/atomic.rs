@@ -399,19 +399,8 @@ mod tests {
         crate::test_support::temp_dir("io", name)
     }
 
-    /// A private device node in `dir` (never the machine's own /dev files); `None`, with a
-    /// message, where mknod is not allowed.
     #[cfg(unix)]
-    fn mknod(dir: &Path, name: &str, minor: u32) -> PathBuf {
-        let p = dir.join(name);
-        let ok = std::process::Command::new("mknod")
-            .arg(&p)
-            .args(["c", "1", &minor.to_string()])
-            .status()
-            .is_ok_and(|s| s.success());
-        assert!(ok, "mknod {} failed: this test needs root", p.display());
-        p
-    }
+    use crate::test_support::mknod;
 
     #[test]
     fn writes_a_new_file_and_replaces_an_old_one_leaving_no_temporary_file() {

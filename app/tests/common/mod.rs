@@ -9,6 +9,12 @@ use std::path::{Path, PathBuf};
 mod data;
 pub use data::{course_dir, meshes_dir, perf_dir, semester_dir};
 
+// The unit tests' helpers, for the one both kinds of test need.
+#[path = "../../src/test_support.rs"]
+mod test_support;
+#[cfg(unix)]
+pub use test_support::mknod;
+
 /// Runs the built `tracelab` with `args` in `dir`, its output captured.
 pub fn tracelab(args: &[&str], dir: &Path) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_tracelab"))
@@ -91,18 +97,4 @@ pub fn settled_harness(
     let mut h = app_harness(scene, size);
     settle(&mut h);
     h
-}
-
-/// A private device node (character device 1, `minor`: 3 null, 7 full), never the machine's
-/// own /dev files; the test needs root (it fails, saying so, where mknod is refused).
-#[cfg(unix)]
-pub fn mknod(dir: &Path, name: &str, minor: u32) -> PathBuf {
-    let p = dir.join(name);
-    let ok = std::process::Command::new("mknod")
-        .arg(&p)
-        .args(["c", "1", &minor.to_string()])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(ok, "mknod {} failed: this test needs root", p.display());
-    p
 }
