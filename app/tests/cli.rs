@@ -257,6 +257,41 @@ fn fmt_writes_canonical_text_that_reads_back() {
     assert!(leftovers.is_empty());
 }
 
+/// A course flag given to `fmt` by mistake, `-object_rays`, is `-o bject_rays` to clap: fmt
+/// wrote a file named `bject_rays` and exited 0. Now a usage error, nothing written; the
+/// spaced, `=` and long forms still write (the control).
+#[test]
+fn fmt_refuses_an_o_value_run_on_that_a_mistyped_flag_would_make() {
+    let d = temp_dir("fmt_run_on");
+    let src = "OrthographicCamera{center 0 0 10 direction 0 0 -1 up 0 1 0 size 5}\nMaterials{numMaterials 1 Material{diffuseColor 1 0 0}}\nGroup{numObjects 1 MaterialIndex 0 Sphere{center 0 0 0 radius 1}}";
+    std::fs::write(d.join("s.txt"), src).expect("write");
+    for (args, file) in [
+        (vec!["fmt", "s.txt", "-object_rays"], "bject_rays"),
+        (vec!["fmt", "-output", "s.txt"], "utput"),
+        (vec!["fmt", "s.txt", "-oout.txt"], "out.txt"),
+    ] {
+        let o = tracelab(&args, &d);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!("`-o {file}`")) && stderr(&o).contains("-o FILE"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+        assert!(o.stdout.is_empty(), "{args:?}");
+        assert!(!d.join(file).exists(), "{args:?} wrote {file}");
+    }
+    for (args, file) in [
+        (vec!["fmt", "s.txt", "-o", "a.txt"], "a.txt"),
+        (vec!["fmt", "s.txt", "-o=b.txt"], "b.txt"),
+        (vec!["fmt", "s.txt", "--output", "c.txt"], "c.txt"),
+        (vec!["fmt", "s.txt", "--output=d.txt"], "d.txt"),
+    ] {
+        let o = tracelab(&args, &d);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert!(d.join(file).is_file(), "{args:?} did not write {file}");
+    }
+}
+
 /// `fmt` rewrites text: it must not need the meshes the scene names (it used to exit 1).
 #[test]
 fn fmt_rewrites_a_scene_whose_obj_file_is_missing() {

@@ -1,5 +1,6 @@
 //! `tracelab fmt`: a scene file rewritten in canonical form.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use tracelab_core::NodeKind;
@@ -47,4 +48,28 @@ pub(super) fn run_fmt(scene: &Path, output: Option<&Path>) -> anyhow::Result<()>
         Some(out) => crate::io::write_atomic(out, text.as_bytes())
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", out.display())),
     }
+}
+
+/// `-oFILE` run together is refused (exit 2) among `fmt`'s arguments (`args` from the
+/// command's name on): clap reads a course flag given to `fmt` by mistake, `-object_rays`,
+/// as `-o bject_rays`, and `fmt` wrote a file of that name and printed nothing (the CLI fuzz
+/// run found it). `-o FILE`, `-o=FILE` and `--output FILE` are unambiguous and accepted.
+pub(super) fn refuse_run_on_output(args: &[OsString]) -> anyhow::Result<()> {
+    for a in args {
+        let b = a.as_encoded_bytes();
+        if b == b"--" {
+            break;
+        }
+        if let Some(rest) = b.strip_prefix(b"-o")
+            && !rest.is_empty()
+            && rest[0] != b'='
+        {
+            let (arg, file) = (a.to_string_lossy(), String::from_utf8_lossy(rest));
+            return Err(crate::exit::usage(format!(
+                "\"{arg}\" would be read as `-o {file}` (write to a file named \"{file}\"); \
+                 fmt has no option {arg}. To write to a file, put a space after -o: -o FILE"
+            )));
+        }
+    }
+    Ok(())
 }

@@ -193,7 +193,10 @@ pub fn run(args: &[OsString]) -> anyhow::Result<()> {
             None => diff::run_diff(&a),
         },
         Some(Command::Animate(a)) => animate::run_animate(&a),
-        Some(Command::Fmt { scene, output }) => fmt::run_fmt(&scene, output.as_deref()),
+        Some(Command::Fmt { scene, output }) => {
+            fmt::refuse_run_on_output(args.get(2..).unwrap_or_default())?;
+            fmt::run_fmt(&scene, output.as_deref())
+        }
         Some(Command::Bench(b)) => with_threads(b.threads, || crate::bench::run(&b)),
         Some(Command::BenchProgressive(b)) => {
             with_threads(b.threads.unwrap_or_else(rayon::current_num_threads), || {
