@@ -91,7 +91,7 @@ impl CameraRays {
     /// The per-column half of every `pixel_ray` of a width × height image, computed once, so
     /// a frame's rays cost no division but the normalisation's.
     pub fn pixel_rays(&self, width: u32, height: u32) -> PixelRays {
-        let columns = (0..width)
+        let columns: Vec<Vec3> = (0..width)
             .map(|i| {
                 let (x, _) = screen_point(i, 0, width, height);
                 let sx = (x - 0.5) * self.extent;
@@ -109,9 +109,11 @@ impl CameraRays {
                 ((y - 0.5) * self.extent) * self.up
             })
             .collect();
+        let soa = [0, 1, 2].map(|a| columns.iter().map(|c: &Vec3| c[a]).collect());
         PixelRays {
             camera: *self,
             columns,
+            soa,
             rows,
         }
     }
@@ -124,6 +126,8 @@ pub struct PixelRays {
     camera: CameraRays,
     /// Perspective: direction + sx·horizontal; orthographic: centre + sx·horizontal.
     columns: Vec<Vec3>,
+    /// `columns` component by component, for loading eight columns at once.
+    soa: [Vec<f32>; 3],
     /// sy·up of each row (counted from the top).
     rows: Vec<Vec3>,
 }
@@ -133,6 +137,7 @@ pub struct PixelRays {
 pub struct RowRays<'a> {
     camera: &'a CameraRays,
     columns: &'a [Vec3],
+    soa: &'a [Vec<f32>; 3],
     sy_up: Vec3,
 }
 
@@ -149,6 +154,7 @@ impl PixelRays {
         RowRays {
             camera: &self.camera,
             columns: &self.columns,
+            soa: &self.soa,
             sy_up,
         }
     }
@@ -157,8 +163,18 @@ impl PixelRays {
 impl RowRays<'_> {
     /// All rays of the row into `out` (cleared first), in one tight loop: with no traversal
     /// between them, each ray's square root and division overlap the next ray's.
+    /// With AVX a perspective camera's rays are made eight at a time (`avx::fill`).
     pub fn fill(&self, out: &mut Vec<Ray>) {
         out.clear();
+        #[cfg(target_arch = "x86_64")]
+        if self.camera.perspective && crate::simd::level() >= crate::simd::Level::Avx {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX, checked just above.
+            unsafe {
+                avx::fill(self, out)
+            };
+            return;
+        }
         out.extend((0..self.columns.len() as u32).map(|i| self.ray(i)));
     }
 
@@ -166,12 +182,78 @@ impl RowRays<'_> {
     /// past the width.
     #[inline]
     pub fn ray(&self, i: u32) -> Ray {
-        let a = self.columns.get(i as usize).copied().unwrap_or(Vec3::ZERO);
         if self.camera.perspective {
-            Ray::new(self.camera.center, (a + self.sy_up).normalize())
+            Ray::new(self.camera.center, self.unnormalised(i).normalize())
         } else {
+            let a = self.columns.get(i as usize).copied().unwrap_or(Vec3::ZERO);
             Ray::new(a + self.sy_up, self.camera.direction)
         }
+    }
+
+    /// A perspective ray's direction before it is normalised.
+    #[inline]
+    fn unnormalised(&self, i: u32) -> Vec3 {
+        self.columns.get(i as usize).copied().unwrap_or(Vec3::ZERO) + self.sy_up
+    }
+}
+
+/// Perspective rays eight at a time. Bit for bit the scalar rays: glam's `normalize` is
+/// x·x + y·y + z·z, its square root, 1 / that and three products, each IEEE-exact in every
+/// lane, so eight lanes give the scalar bits (a test checks it). The inputs are loaded
+/// from the long-lived columns, not from a just-written array: 16-byte loads across 4-byte
+/// stores failed store forwarding and made a first version slower than the scalar loop.
+/// Only whole rows gain (`tracelab bench`): the editor's packets gather eight pixels from two
+/// rows of a pass's grid, and eight at a time made its frame 2% slower (`docs/perf.md`).
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use std::arch::x86_64::*;
+
+    use glam::Vec3;
+
+    use super::{Ray, RowRays};
+
+    /// Unit directions of eight lanes (x, y, z) as eight floats per component.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn normalized_lanes(x: __m256, y: __m256, z: __m256) -> [[f32; 8]; 3] {
+        let (add, mul) = (_mm256_add_ps, _mm256_mul_ps);
+        let dot = add(add(mul(x, x), mul(y, y)), mul(z, z));
+        let r = _mm256_div_ps(_mm256_set1_ps(1.0), _mm256_sqrt_ps(dot));
+        [mul(x, r), mul(y, r), mul(z, r)].map(|m| {
+            let mut a = [0.0f32; 8];
+            #[allow(unsafe_code)]
+            // SAFETY: `a` holds eight floats; the store is unaligned.
+            unsafe {
+                _mm256_storeu_ps(a.as_mut_ptr(), m)
+            };
+            a
+        })
+    }
+
+    /// `RowRays::fill` for a perspective camera.
+    #[target_feature(enable = "avx")]
+    pub(super) fn fill(r: &RowRays, out: &mut Vec<Ray>) {
+        let n = r.columns.len();
+        let up = [r.sy_up.x, r.sy_up.y, r.sy_up.z].map(|u| _mm256_set1_ps(u));
+        let mut x0 = 0;
+        while x0 + 8 <= n {
+            let column = |a: usize| {
+                let row = r.soa[a]
+                    .get(x0..x0 + 8)
+                    .and_then(|s| <&[f32; 8]>::try_from(s).ok());
+                #[allow(unsafe_code)]
+                // SAFETY: eight contiguous floats, what an unaligned 256-bit load reads.
+                row.map_or(up[a], |s| unsafe { _mm256_loadu_ps(s.as_ptr()) })
+            };
+            let x = _mm256_add_ps(column(0), up[0]);
+            let y = _mm256_add_ps(column(1), up[1]);
+            let z = _mm256_add_ps(column(2), up[2]);
+            let [dx, dy, dz] = normalized_lanes(x, y, z);
+            let center = r.camera.center;
+            out.extend((0..8).map(|k| Ray::new(center, Vec3::new(dx[k], dy[k], dz[k]))));
+            x0 += 8;
+        }
+        out.extend((x0 as u32..n as u32).map(|i| r.ray(i)));
     }
 }
 
