@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """A/B of `tracelab bench` on a noisy machine: the four bench meshes (../shared/perf, from the
-checkout), single rays and 8-ray packets, 800x800, 1 thread, the two binaries alternating (the
-order swapped every round), ROUNDS rounds. Prints each binary's tree shape and bytes per
-triangle, then per scene and mode the medians over the rounds of Mrays/s and build_ms, the
-median of the per-round ratios B / A, and whether hits and sum_t were the same in every run.
-Copy the base binary aside first: the binaries are compared as given.
+checkout), single rays and 8-ray packets, 800x800, 1 thread, the binaries in turn (the order
+rotated every round), ROUNDS rounds. Prints each binary's tree shape and bytes per triangle,
+then per scene and mode the medians over the rounds of Mrays/s and build_ms, the median of the
+per-round ratios to the first binary (A), and whether hits and sum_t were the same in every
+run. Copy the base binary aside first: the binaries are compared as given.
 
-usage: tools/ab_bench.py ROUNDS A B [REPEAT]   (REPEAT: bench's --repeat, default 15)
+usage: tools/ab_bench.py ROUNDS A B [C ...] [--repeat N]   (bench's --repeat, default 15)
 """
 import os
 import re
@@ -17,8 +17,16 @@ import time
 
 root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 perf = os.path.join(root, "..", "shared", "perf")
-rounds, A, B = int(sys.argv[1]), os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
-rep = sys.argv[4] if len(sys.argv) > 4 else "15"
+args = sys.argv[1:]
+rep = "15"
+if "--repeat" in args:
+    i = args.index("--repeat")
+    rep = args[i + 1]
+    del args[i : i + 2]
+if len(args) < 3 or not args[0].isdigit():
+    sys.exit(__doc__)
+rounds, bins = int(args[0]), [os.path.abspath(b) for b in args[1:]]
+tags = [chr(ord("A") + i) for i in range(len(bins))]
 scenes = ["bench_cube.txt", "bench_bunny1k.txt", "bench_bunny69k.txt", "bench_dragon871k.txt"]
 modes = ["single", "packets"]
 
@@ -45,7 +53,8 @@ def bench(binary, scene, mode):
 res, shapes = {}, {}
 print("start", now(), "UTC, load", load(), flush=True)
 for r in range(rounds):
-    order = [("A", A), ("B", B)] if r % 2 == 0 else [("B", B), ("A", A)]
+    k = r % len(bins)
+    order = list(zip(tags, bins))[k:] + list(zip(tags, bins))[:k]
     for s in scenes:
         for mode in modes:
             for tag, b in order:
@@ -53,16 +62,23 @@ for r in range(rounds):
                 res.setdefault((s, mode, tag), []).append(row)
     print("round", r + 1, "done", now(), "load", load(), flush=True)
 print("end", now(), "UTC, load", load())
+for tag, b in zip(tags, bins):
+    print(tag, "=", b)
 for s in scenes:
-    for tag in "AB":
+    for tag in tags:
         print(s, tag, *shapes[(s, tag)], sep=" | ")
-print(f"{'scene':22} {'mode':8} {'A Mrays':>8} {'B Mrays':>8} {'B/A':>6} {'A build':>8} {'B build':>8}  checksums")
+med = lambda rows, k: statistics.median(x[k] for x in rows)
+head = "".join(f" {t + ' Mrays':>9} {t + '/A':>6} {t + ' build':>8}" for t in tags)
+print(f"{'scene':22} {'mode':8}{head}  checksums")
 for s in scenes:
     for mode in modes:
-        a, b = res[(s, mode, "A")], res[(s, mode, "B")]
-        med = lambda rows, k: statistics.median(x[k] for x in rows)
-        ratio = statistics.median(y[0] / x[0] for x, y in zip(a, b))
-        sums = {(x[1], x[2]) for x in a + b}
+        a = res[(s, mode, "A")]
+        line = f"{s:22} {mode:8}"
+        for t in tags:
+            x = res[(s, mode, t)]
+            ratio = statistics.median(q[0] / p[0] for p, q in zip(a, x))
+            line += f" {med(x, 0):9.2f} {ratio:6.3f} {med(x, 3):8.2f}"
+        rows = [row for t in tags for row in res[(s, mode, t)]]
+        sums = {(x[1], x[2]) for x in rows}
         same = f"same hits={a[0][1]} sum_t={a[0][2]}" if len(sums) == 1 else f"DIFFER {sorted(sums)}"
-        print(f"{s:22} {mode:8} {med(a, 0):8.2f} {med(b, 0):8.2f} {ratio:6.3f} "
-              f"{med(a, 3):8.2f} {med(b, 3):8.2f}  {same}")
+        print(f"{line}  {same}")
