@@ -163,19 +163,26 @@ impl PixelRays {
 impl RowRays<'_> {
     /// All rays of the row into `out` (cleared first), in one tight loop: with no traversal
     /// between them, each ray's square root and division overlap the next ray's.
-    /// With AVX a perspective camera's rays are made eight at a time (`avx::fill`).
     pub fn fill(&self, out: &mut Vec<Ray>) {
         out.clear();
+        self.fill_range(0, self.columns.len() as u32, out);
+    }
+
+    /// The rays of columns `x0..x1` (within the row) appended to `out`. With AVX a
+    /// perspective camera's rays are made eight at a time (`avx::fill`).
+    pub fn fill_range(&self, x0: u32, x1: u32, out: &mut Vec<Ray>) {
+        let x1 = x1.min(self.columns.len() as u32);
+        let x0 = x0.min(x1);
         #[cfg(target_arch = "x86_64")]
         if self.camera.perspective && crate::simd::level() >= crate::simd::Level::Avx {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX, checked just above.
             unsafe {
-                avx::fill(self, out)
+                avx::fill(self, x0 as usize, x1 as usize, out)
             };
             return;
         }
-        out.extend((0..self.columns.len() as u32).map(|i| self.ray(i)));
+        out.extend((x0..x1).map(|i| self.ray(i)));
     }
 
     /// The ray through pixel `i` of this row (`pixel_ray`'s, bit for bit); the origin for i
@@ -230,13 +237,12 @@ mod avx {
         })
     }
 
-    /// `RowRays::fill` for a perspective camera.
+    /// `RowRays::fill_range` for a perspective camera (`x0 <= x1 <= ` the row's width).
     #[target_feature(enable = "avx")]
-    pub(super) fn fill(r: &RowRays, out: &mut Vec<Ray>) {
-        let n = r.columns.len();
+    pub(super) fn fill(r: &RowRays, x0: usize, x1: usize, out: &mut Vec<Ray>) {
         let up = [r.sy_up.x, r.sy_up.y, r.sy_up.z].map(|u| _mm256_set1_ps(u));
-        let mut x0 = 0;
-        while x0 + 8 <= n {
+        let mut x0 = x0;
+        while x0 + 8 <= x1 {
             let column = |a: usize| {
                 let row = r.soa[a]
                     .get(x0..x0 + 8)
@@ -253,7 +259,7 @@ mod avx {
             out.extend((0..8).map(|k| Ray::new(center, Vec3::new(dx[k], dy[k], dz[k]))));
             x0 += 8;
         }
-        out.extend((x0 as u32..n as u32).map(|i| r.ray(i)));
+        out.extend((x0 as u32..x1 as u32).map(|i| r.ray(i)));
     }
 }
 
@@ -335,6 +341,16 @@ mod tests {
                             r.ray(i),
                             "fill, {w}x{h} pixel ({i}, {row})"
                         );
+                    }
+                    // Ranges that start off the eight-lane grid, and past the width.
+                    for (x0, x1) in [(3, 12), (1, w), (w / 2, w + 9), (w, w + 1)] {
+                        let mut part = vec![Ray::new(Vec3::ZERO, Vec3::X)];
+                        r.fill_range(x0, x1, &mut part);
+                        let want = x1.min(w).saturating_sub(x0.min(w)) as usize;
+                        assert_eq!(part.len(), 1 + want, "{w}x{h} {x0}..{x1}");
+                        for (k, ray) in part[1..].iter().enumerate() {
+                            assert_eq!(*ray, r.ray(x0 + k as u32), "{w}x{h} {x0}..{x1} +{k}");
+                        }
                     }
                 }
             }

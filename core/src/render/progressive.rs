@@ -78,11 +78,26 @@ fn trace_packets(
     // Every miss stores the same sample: quantise the background once, not per pixel.
     let mut miss = Sample::UNSET;
     store_sample(scene, &mut miss, None, (glam::Vec3::ZERO, glam::Vec3::ZERO));
+    // The full pass's rays row by row first, where a perspective row's are made eight at a
+    // time (`RowRays::fill_range`); the coarse passes' points are too sparse for it.
+    let mut tile_rays = Vec::new();
+    if pass.scale == 1 {
+        tile_rays.reserve(pass.points());
+        for j in 0..pass.gh {
+            let (x0, row) = pass.pixel(0, j);
+            rays.row(row).fill_range(x0, x0 + pass.gw, &mut tile_rays);
+        }
+    }
     for chunk in pts.chunks(8) {
         let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
         for (k, &(i, j)) in chunk.iter().enumerate() {
-            let (x, row) = pass.pixel(i, j);
-            r[k] = rays.row(row).ray(x);
+            r[k] = match tile_rays.get(pass.index(i, j)) {
+                Some(ray) => *ray,
+                None => {
+                    let (x, row) = pass.pixel(i, j);
+                    rays.row(row).ray(x)
+                }
+            };
         }
         let active = ((1u16 << chunk.len()) - 1) as u8;
         let hits = scene.intersect8_with(
