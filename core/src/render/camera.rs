@@ -209,8 +209,9 @@ impl RowRays<'_> {
 /// lane, so eight lanes give the scalar bits (a test checks it). The inputs are loaded
 /// from the long-lived columns, not from a just-written array: 16-byte loads across 4-byte
 /// stores failed store forwarding and made a first version slower than the scalar loop.
-/// Only whole rows gain (`tracelab bench`): the editor's packets gather eight pixels from two
-/// rows of a pass's grid, and eight at a time made its frame 2% slower (`docs/perf.md`).
+/// Only runs of a row gain (`tracelab bench`'s rows, the editor's full pass per tile row):
+/// gathering a packet's eight pixels into lanes made the editor's frame 2% slower
+/// (`docs/perf.md`).
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::*;
