@@ -87,6 +87,11 @@ fn trace_packets(
             let (x0, row) = pass.pixel(0, j);
             rays.row(row).fill_range(x0, x0 + pass.gw, &mut tile_rays);
         }
+        // `pass.index` assumes every row gave its gw rays; a tile reaching past the image
+        // (never made) would shift them: then one ray at a time, as the coarse passes.
+        if tile_rays.len() != pass.points() {
+            tile_rays.clear();
+        }
     }
     for chunk in pts.chunks(8) {
         let mut r = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); 8];
