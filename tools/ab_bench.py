@@ -6,7 +6,8 @@ then per scene and mode the medians over the rounds of Mrays/s and build_ms, the
 per-round ratios to the first binary (A), and whether hits and sum_t were the same in every
 run. Copy the base binary aside first: the binaries are compared as given.
 
-usage: tools/ab_bench.py ROUNDS A B [C ...] [--repeat N]   (bench's --repeat, default 15)
+usage: tools/ab_bench.py ROUNDS A B [C ...] [--repeat N] [--single]
+       (--repeat: bench's --repeat, default 15; --single: single rays only, no packets)
 """
 import os
 import re
@@ -23,12 +24,15 @@ if "--repeat" in args:
     i = args.index("--repeat")
     rep = args[i + 1]
     del args[i : i + 2]
+single = "--single" in args
+if single:
+    args.remove("--single")
 if len(args) < 3 or not args[0].isdigit():
     sys.exit(__doc__)
 rounds, bins = int(args[0]), [os.path.abspath(b) for b in args[1:]]
 tags = [chr(ord("A") + i) for i in range(len(bins))]
 scenes = ["bench_cube.txt", "bench_bunny1k.txt", "bench_bunny69k.txt", "bench_dragon871k.txt"]
-modes = ["single", "packets"]
+modes = ["single"] if single else ["single", "packets"]
 
 
 def load():
