@@ -198,10 +198,8 @@ pub(super) fn leaf8<L: LeafRay, const CALLER: u8>(
             _mm256_cmp_ps::<_CMP_LE_OQ>(u, abs_det),
         ),
     );
-    // Most leaves a ray enters hold no triangle it crosses: stop before the second half.
-    if _mm256_movemask_ps(ok) as u32 & lanes & !slow == 0 && slow == 0 {
-        return None;
-    }
+    // No early return when no lane passes the u test: a branch on the data, taken or not
+    // leaf by leaf; always doing the second half was 2-3% faster (`docs/perf.md`).
     let (qx, qy, qz) = cross(sx, sy, sz, e1x, e1y, e1z);
     let v_det = dot(dx, dy, dz, qx, qy, qz);
     let v = _mm256_xor_ps(v_det, sign);
@@ -216,10 +214,20 @@ pub(super) fn leaf8<L: LeafRay, const CALLER: u8>(
         _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(t_min)),
         _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_best)),
     );
-    let mut mask = (_mm256_movemask_ps(_mm256_andnot_ps(reject, _mm256_and_ps(ok, in_range)))
-        as u32)
-        & lanes
-        & !slow;
+    let hit = _mm256_andnot_ps(reject, _mm256_and_ps(ok, in_range));
+    let mut mask = (_mm256_movemask_ps(hit) as u32) & lanes & !slow;
+    if slow == 0 {
+        if mask == 0 {
+            return None;
+        }
+        // Lanes past the leaf masked off as vectors too (lane index < count).
+        let lane = _mm256_set_ps(7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.0, 0.0);
+        let used = _mm256_cmp_ps::<_CMP_LT_OQ>(lane, _mm256_set1_ps(count as f32));
+        let (t_near, at) = nearest(t, _mm256_and_ps(hit, used));
+        if let Some(t_near) = t_near {
+            return Some((t_near, first + at));
+        }
+    }
     let mut ts = [0.0f32; WIDTH];
     store8(&mut ts, t);
     let mut rest = slow;
@@ -247,4 +255,24 @@ pub(super) fn leaf8<L: LeafRay, const CALLER: u8>(
         }
     }
     Some(best)
+}
+
+/// The smallest t among the lanes set in `hit` (at least one), and the lowest such lane: the
+/// scalar loop's choice (strictly closer replaces, so the first of equal t wins). In
+/// registers, because the walk waits for t; the lane is off that path. None for a minimum
+/// of ±0 (possible only with t_min < 0): equal there, they differ in bits, so the caller
+/// takes its loop.
+#[target_feature(enable = "avx")]
+#[inline]
+pub(super) fn nearest(t: __m256, hit: __m256) -> (Option<f32>, usize) {
+    let tm = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, hit);
+    let m = _mm256_min_ps(tm, _mm256_permute2f128_ps::<1>(tm, tm));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b0100_1110>(m));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b1011_0001>(m));
+    let t_near = _mm256_cvtss_f32(m);
+    let at = _mm256_movemask_ps(_mm256_and_ps(hit, _mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)));
+    (
+        (t_near != 0.0).then_some(t_near),
+        at.trailing_zeros() as usize,
+    )
 }

@@ -64,9 +64,7 @@ pub(super) fn leaf8<L: avx::LeafRay, const CALLER: u8>(
     let ok = _mm256_mask_cmp_ps_mask::<_CMP_NEQ_OQ>(lanes & !slow, det, zero);
     let ok = _mm256_mask_cmp_ps_mask::<_CMP_GE_OQ>(ok, u, zero);
     let ok = _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(ok, u, abs_det);
-    if ok == 0 && slow == 0 {
-        return None;
-    }
+    // No early return here, as in `avx::leaf8`.
     let (qx, qy, qz) = cross(sx, sy, sz, e1x, e1y, e1z);
     let v = _mm256_xor_ps(dot(dx, dy, dz, qx, qy, qz), sign);
     let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
@@ -76,6 +74,16 @@ pub(super) fn leaf8<L: avx::LeafRay, const CALLER: u8>(
     let in_range = _mm256_mask_cmp_ps_mask::<_CMP_GT_OQ>(ok & !reject, t, _mm256_set1_ps(t_min));
     let mut mask =
         _mm256_mask_cmp_ps_mask::<_CMP_LT_OQ>(in_range, t, _mm256_set1_ps(t_best)) as u32;
+    if slow == 0 {
+        if mask == 0 {
+            return None;
+        }
+        // The nearest hit in registers (`avx::nearest`).
+        let (t_near, at) = nearest(t, mask as u8);
+        if let Some(t_near) = t_near {
+            return Some((t_near, first + at));
+        }
+    }
     let mut ts = [0.0f32; WIDTH];
     avx::store8(&mut ts, t);
     let mut rest = slow as u32;
@@ -102,4 +110,20 @@ pub(super) fn leaf8<L: avx::LeafRay, const CALLER: u8>(
         }
     }
     Some(best)
+}
+
+/// `avx::nearest` with the lanes as a mask register.
+#[target_feature(enable = "avx512f,avx512vl")]
+#[inline]
+fn nearest(t: __m256, hit: u8) -> (Option<f32>, usize) {
+    let tm = _mm256_mask_blend_ps(hit, _mm256_set1_ps(f32::INFINITY), t);
+    let m = _mm256_min_ps(tm, _mm256_permute2f128_ps::<1>(tm, tm));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b0100_1110>(m));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b1011_0001>(m));
+    let t_near = _mm256_cvtss_f32(m);
+    let at = _mm256_mask_cmp_ps_mask::<_CMP_EQ_OQ>(hit, t, m);
+    (
+        (t_near != 0.0).then_some(t_near),
+        at.trailing_zeros() as usize,
+    )
 }

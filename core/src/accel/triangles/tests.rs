@@ -137,6 +137,23 @@ fn random_rays_agree_with_brute_force_on_random_meshes() {
     }
 }
 
+/// Every triangle twice, so a hit is a tie at the very same t inside a leaf: every path
+/// (AVX-512, AVX, portable) picks the same one, the first in leaf order, as the scalar loop
+/// does. (Fails if a leaf test picks the last lane of the tie instead.)
+#[test]
+fn ties_inside_a_leaf_go_the_same_way_on_every_path() {
+    let (pos, tris) = random_mesh(150, 57);
+    let twice: Vec<[u32; 3]> = tris.iter().flat_map(|&t| [t, t]).collect();
+    let bvh = build_checked(&pos, &twice);
+    let rays = rays_toward(Vec3::ZERO, 2.0, 2000, 59);
+    assert_agrees(&pos, &twice, &bvh, &rays);
+    let hits = rays
+        .iter()
+        .filter(|r| bvh.intersect(r, 0.0, f32::INFINITY).is_some())
+        .count();
+    assert!(hits > 300, "{hits} of {} rays hit", rays.len());
+}
+
 /// Both leaf sizings (the AVX one and the one for CPUs without it) build valid trees that
 /// find the brute-force hits; the AVX sizing makes leaves of several triangles.
 #[test]
