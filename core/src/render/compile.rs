@@ -397,15 +397,11 @@ impl CompiledScene {
     #[inline(always)]
     fn mesh_hit(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
         let (org, dir) = match &o.xf {
-            // Direction deliberately not renormalised: t is the same in both spaces.
-            Some(xf) => (
-                xf.object_from_world.transform_point3(ray.origin),
-                xf.object_from_world.transform_vector3(ray.direction),
-            ),
-            None => (ray.origin, ray.direction),
+            Some(xf) => xf.object_ray(ray.origin, ray.direction),
+            None => (ray.origin.into(), ray.direction.into()),
         };
         m.accel
-            .closest_hit(Vec3A::from(org), Vec3A::from(dir), t_min, t_max)
+            .closest_hit(org, dir, t_min, t_max)
             .map(|h| (h.t, h.triangle))
     }
 

@@ -3,8 +3,6 @@
 //! `intersect(..).is_some()`, bit for bit: each step is the closest-hit path's own
 //! arithmetic, cut short.
 
-use glam::Vec3A;
-
 use super::compile::{CompiledScene, Object, Shape};
 use crate::geometry::Ray;
 use crate::scene::Mesh;
@@ -64,15 +62,10 @@ impl CompiledScene {
 #[inline]
 fn mesh_occludes(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> bool {
     let (org, dir) = match &o.xf {
-        // Direction deliberately not renormalised: t is the same in both spaces.
-        Some(xf) => (
-            xf.object_from_world.transform_point3(ray.origin),
-            xf.object_from_world.transform_vector3(ray.direction),
-        ),
-        None => (ray.origin, ray.direction),
+        Some(xf) => xf.object_ray(ray.origin, ray.direction),
+        None => (ray.origin.into(), ray.direction.into()),
     };
-    m.accel
-        .any_hit(Vec3A::from(org), Vec3A::from(dir), t_min, t_max)
+    m.accel.any_hit(org, dir, t_min, t_max)
 }
 
 #[cfg(test)]
