@@ -256,18 +256,12 @@ impl TriangleBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
-        closest_hit_with::<false>(
-            self,
-            &SlabRay::new(o, d),
-            t_min,
-            t_max,
-            |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
-            },
-            |r, first, count, t_min, t_best| {
-                avx::leaf8::<_, { caller::CLOSEST }>(self, r, first, count, t_min, t_best)
-            },
-        )
+        let r = SlabRay::new(o, d);
+        #[allow(unsafe_code)]
+        // SAFETY: this function enables AVX, what `by_octant` needs.
+        unsafe {
+            self.by_octant::<false, false>(&r, t_min, t_max)
+        }
     }
 
     /// The closest hit with AVX-512 (F and VL): `closest_hit_avx`'s walk and 8-box test
@@ -283,18 +277,12 @@ impl TriangleBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
-        closest_hit_with::<false>(
-            self,
-            &SlabRay::new(o, d),
-            t_min,
-            t_max,
-            |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
-            },
-            |r, first, count, t_min, t_best| {
-                avx512::leaf8::<_, { caller::CLOSEST }>(self, r, first, count, t_min, t_best)
-            },
-        )
+        let r = SlabRay::new(o, d);
+        #[allow(unsafe_code)]
+        // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
+        unsafe {
+            self.by_octant::<false, true>(&r, t_min, t_max)
+        }
     }
 
     /// Whether any triangle is hit with t in (t_min, t_max): a shadow ray's question. It
@@ -339,38 +327,119 @@ impl TriangleBvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn any_hit_avx(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        closest_hit_with::<true>(
-            self,
-            &SlabRay::new(o, d),
-            t_min,
-            t_max,
-            |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
-            },
-            |r, first, count, t_min, t_best| {
-                avx::leaf8::<_, { caller::ANY }>(self, r, first, count, t_min, t_best)
-            },
-        )
-        .is_some()
+        let r = SlabRay::new(o, d);
+        #[allow(unsafe_code)]
+        // SAFETY: this function enables AVX, what `by_octant` needs.
+        unsafe { self.by_octant::<true, false>(&r, t_min, t_max) }.is_some()
     }
 
     /// `any_hit` with the kernels of `closest_hit_avx512`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
     fn any_hit_avx512(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        closest_hit_with::<true>(
+        let r = SlabRay::new(o, d);
+        #[allow(unsafe_code)]
+        // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
+        unsafe { self.by_octant::<true, true>(&r, t_min, t_max) }.is_some()
+    }
+
+    /// The AVX walk (`WIDE`: with the AVX-512 leaf test) for the ray's octant: one copy of
+    /// the walk per combination of direction signs, so each 8-box test reads its entry and
+    /// exit rows at offsets fixed when compiled rather than chosen per node (tinybvh's
+    /// `BVH8_CPU` does the same). On Zen 5, single rays on the Stanford bunny and the
+    /// dragon +2-3% with AVX-512 and +10-11% with AVX (16 vector registers: a copy per
+    /// octant needs fewer of them), the editor's Whitted frames even (`docs/perf.md`).
+    /// Choosing the rows by blends in one copy gained nothing, so it is not the rows alone.
+    /// `FIRST`: stop at the first hit (`any_hit`).
+    ///
+    /// # Safety
+    /// The CPU must have AVX, and AVX-512 F and VL when `WIDE`; called only from functions
+    /// that enable them, into which it is inlined.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn by_octant<const FIRST: bool, const WIDE: bool>(
+        &self,
+        r: &SlabRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        #[allow(unsafe_code)]
+        // SAFETY: the caller's features, as this function's contract says.
+        unsafe {
+            match r.toward_neg {
+                [false, false, false] => {
+                    self.walk::<FIRST, WIDE, false, false, false>(r, t_min, t_max)
+                }
+                [false, false, true] => {
+                    self.walk::<FIRST, WIDE, false, false, true>(r, t_min, t_max)
+                }
+                [false, true, false] => {
+                    self.walk::<FIRST, WIDE, false, true, false>(r, t_min, t_max)
+                }
+                [false, true, true] => self.walk::<FIRST, WIDE, false, true, true>(r, t_min, t_max),
+                [true, false, false] => {
+                    self.walk::<FIRST, WIDE, true, false, false>(r, t_min, t_max)
+                }
+                [true, false, true] => self.walk::<FIRST, WIDE, true, false, true>(r, t_min, t_max),
+                [true, true, false] => self.walk::<FIRST, WIDE, true, true, false>(r, t_min, t_max),
+                [true, true, true] => self.walk::<FIRST, WIDE, true, true, true>(r, t_min, t_max),
+            }
+        }
+    }
+
+    /// `by_octant`'s walk for rays running toward -x, -y, -z where `NX`, `NY`, `NZ`.
+    ///
+    /// # Safety
+    /// As `by_octant`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn walk<
+        const FIRST: bool,
+        const WIDE: bool,
+        const NX: bool,
+        const NY: bool,
+        const NZ: bool,
+    >(
+        &self,
+        r: &SlabRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        closest_hit_with::<FIRST>(
             self,
-            &SlabRay::new(o, d),
+            r,
             t_min,
             t_max,
             |r, n, t_min, t_max, t_enter| {
-                avx::slab8(n, r.o, r.inv, r.toward_neg, t_min, t_max, t_enter)
+                #[allow(unsafe_code)]
+                // SAFETY: the caller has AVX (this function's contract).
+                unsafe {
+                    avx::slab8(n, r.o, r.inv, [NX, NY, NZ], t_min, t_max, t_enter)
+                }
             },
             |r, first, count, t_min, t_best| {
-                avx512::leaf8::<_, { caller::ANY }>(self, r, first, count, t_min, t_best)
+                #[allow(unsafe_code)]
+                // SAFETY: the caller has AVX, and AVX-512 F and VL when WIDE (the contract).
+                unsafe {
+                    match (WIDE, FIRST) {
+                        (true, false) => avx512::leaf8::<_, { caller::CLOSEST }>(
+                            self, r, first, count, t_min, t_best,
+                        ),
+                        (true, true) => avx512::leaf8::<_, { caller::ANY }>(
+                            self, r, first, count, t_min, t_best,
+                        ),
+                        (false, false) => avx::leaf8::<_, { caller::CLOSEST }>(
+                            self, r, first, count, t_min, t_best,
+                        ),
+                        (false, true) => {
+                            avx::leaf8::<_, { caller::ANY }>(self, r, first, count, t_min, t_best)
+                        }
+                    }
+                }
             },
         )
-        .is_some()
     }
 
     /// The nearest hit in (t_min, t_best) among triangles first..first+count, one at a time:
