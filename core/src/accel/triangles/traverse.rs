@@ -89,6 +89,25 @@ impl LeafRay for SlabRay {
     }
 }
 
+/// A `SlabRay` in the octant of direction signs `NX`, `NY`, `NZ` (true: toward -axis), as
+/// the leaf tests read it: the same ray, a type per octant, so that each octant's walk
+/// (`TriangleBvh::by_octant`) has its own copy of the leaf test to inline. With eight walks
+/// calling one copy, LLVM left it a call, and the walks spilled their registers around it.
+#[cfg(target_arch = "x86_64")]
+struct InOctant<'a, const NX: bool, const NY: bool, const NZ: bool>(&'a SlabRay);
+
+#[cfg(target_arch = "x86_64")]
+impl<const NX: bool, const NY: bool, const NZ: bool> LeafRay for InOctant<'_, NX, NY, NZ> {
+    #[inline(always)]
+    fn origin(&self) -> Vec3A {
+        self.0.o
+    }
+    #[inline(always)]
+    fn direction(&self) -> Vec3A {
+        self.0.d
+    }
+}
+
 /// Where the traversal goes from a node whose slots in `mask` the ray enters, at distances
 /// `t_enter`: returns the nearest slot's entry to visit now and pushes the others so the
 /// nearest of them pops first. One slot: itself; two: the far one pushed, no sort (the lower
@@ -420,15 +439,20 @@ impl TriangleBvh {
                 }
             },
             |r, first, count, t_min, t_best| {
+                // With AVX-512 the ray typed by its octant, so each copy of the walk calls a
+                // leaf test of its own, which LLVM inlines (`avx::leaf8`'s `CALLER`). Not
+                // with AVX: in 16 vector registers the inlined test made the walks 1-3%
+                // slower than one shared copy (`docs/perf.md`).
+                let o = &InOctant::<NX, NY, NZ>(r);
                 #[allow(unsafe_code)]
                 // SAFETY: the caller has AVX, and AVX-512 F and VL when WIDE (the contract).
                 unsafe {
                     match (WIDE, FIRST) {
                         (true, false) => avx512::leaf8::<_, { caller::CLOSEST }>(
-                            self, r, first, count, t_min, t_best,
+                            self, o, first, count, t_min, t_best,
                         ),
                         (true, true) => avx512::leaf8::<_, { caller::ANY }>(
-                            self, r, first, count, t_min, t_best,
+                            self, o, first, count, t_min, t_best,
                         ),
                         (false, false) => avx::leaf8::<_, { caller::CLOSEST }>(
                             self, r, first, count, t_min, t_best,
