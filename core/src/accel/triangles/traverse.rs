@@ -366,9 +366,10 @@ impl TriangleBvh {
     /// the walk per combination of direction signs, so each 8-box test reads its entry and
     /// exit rows at offsets fixed when compiled rather than chosen per node (tinybvh's
     /// `BVH8_CPU` does the same). On Zen 5, single rays on the Stanford bunny and the
-    /// dragon +2-3% with AVX-512 and +10-11% with AVX (16 vector registers: a copy per
-    /// octant needs fewer of them), the editor's Whitted frames even (`docs/perf.md`).
-    /// Choosing the rows by blends in one copy gained nothing, so it is not the rows alone.
+    /// dragon +2-3% with AVX-512 (2-4% more once each copy inlined its own leaf test,
+    /// `InOctant`) and +10-11% with AVX (16 vector registers: a copy per octant needs fewer
+    /// of them), the editor's Whitted frames even or faster (`docs/perf.md`). Choosing the
+    /// rows by blends in one copy gained nothing, so it is not the rows alone.
     /// `FIRST`: stop at the first hit (`any_hit`).
     ///
     /// # Safety
