@@ -79,7 +79,7 @@ impl Transform {
 
 #[cfg(test)]
 mod tests {
-    use glam::{DMat4, DQuat, DVec3, Vec3};
+    use glam::{DMat4, DQuat, DVec3, DVec4, Vec3};
 
     use super::Transform;
 
@@ -100,24 +100,12 @@ mod tests {
             let scale = DVec3::new(f() as f64, f() as f64, f() as f64) * 7.0 + 0.01;
             let turn = DQuat::from_euler(glam::EulerRot::XYZ, f() as f64, f() as f64, 3.0);
             let shift = DVec3::new(f() as f64, f() as f64, f() as f64) * 30.0;
-            let shear = DMat4::from_cols_array(&[
-                1.0,
-                f() as f64,
-                0.0,
-                0.0,
-                0.0,
-                1.0,
-                0.0,
-                0.0,
-                f() as f64,
-                0.0,
-                1.0,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                1.0,
-            ]);
+            let shear = DMat4::from_cols(
+                DVec4::new(1.0, f() as f64, 0.0, 0.0),
+                DVec4::Y,
+                DVec4::new(f() as f64, 0.0, 1.0, 0.0),
+                DVec4::W,
+            );
             let m = DMat4::from_scale_rotation_translation(scale, turn, shift) * shear;
             let xf = if k % 2 == 0 {
                 Transform::from_f64(m)

@@ -44,6 +44,19 @@ pub struct Object {
     pub node: NodeId,
 }
 
+impl Object {
+    /// A world ray in this object's space, as a mesh's traversal takes it
+    /// (`Transform::object_ray`); `mesh_hit` and the shadow rays' `mesh_occludes` both use
+    /// it, so a mesh sees the same bits from either.
+    #[inline(always)]
+    pub(super) fn object_ray(&self, ray: &Ray) -> (Vec3A, Vec3A) {
+        match &self.xf {
+            Some(xf) => xf.object_ray(ray.origin, ray.direction),
+            None => (ray.origin.into(), ray.direction.into()),
+        }
+    }
+}
+
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
@@ -304,7 +317,9 @@ impl CompiledScene {
         self.intersect_scene8(rays, active, t_min, t_max)
     }
 
-    /// Eight rays in a mesh instance's object space, computed exactly as `mesh_hit` does.
+    /// Eight rays in a mesh instance's object space, the bits of `mesh_hit`'s (`Mat4` here,
+    /// `Object::object_ray`'s `Affine3A` there: the same operations, a test in
+    /// `geometry::transform` compares them).
     #[inline(always)]
     fn object_rays8(o: &Object, rays: &[Ray; 8]) -> ([Vec3A; 8], [Vec3A; 8]) {
         match &o.xf {
@@ -396,10 +411,7 @@ impl CompiledScene {
     /// the matrix product reads one at a time), then the mesh BVH, which takes 16-byte vectors.
     #[inline(always)]
     fn mesh_hit(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
-        let (org, dir) = match &o.xf {
-            Some(xf) => xf.object_ray(ray.origin, ray.direction),
-            None => (ray.origin.into(), ray.direction.into()),
-        };
+        let (org, dir) = o.object_ray(ray);
         m.accel
             .closest_hit(org, dir, t_min, t_max)
             .map(|h| (h.t, h.triangle))

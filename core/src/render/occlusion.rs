@@ -61,10 +61,7 @@ impl CompiledScene {
 /// to object space by the very operations `mesh_hit` uses, so the mesh sees the same bits.
 #[inline]
 fn mesh_occludes(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> bool {
-    let (org, dir) = match &o.xf {
-        Some(xf) => xf.object_ray(ray.origin, ray.direction),
-        None => (ray.origin.into(), ray.direction.into()),
-    };
+    let (org, dir) = o.object_ray(ray);
     m.accel.any_hit(org, dir, t_min, t_max)
 }
 

@@ -264,7 +264,7 @@ pub(super) fn leaf8<L: LeafRay, const CALLER: u8>(
 /// takes its loop.
 #[target_feature(enable = "avx")]
 #[inline]
-pub(super) fn nearest(t: __m256, hit: __m256) -> (Option<f32>, usize) {
+fn nearest(t: __m256, hit: __m256) -> (Option<f32>, usize) {
     let tm = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, hit);
     let m = _mm256_min_ps(tm, _mm256_permute2f128_ps::<1>(tm, tm));
     let m = _mm256_min_ps(m, _mm256_permute_ps::<0b0100_1110>(m));
