@@ -130,13 +130,12 @@ pub(super) fn nearest_first<E: StackEntry>(
     }
     if rest & (rest - 1) == 0 {
         let j = rest.trailing_zeros() as usize;
-        let (near, far) = if t_enter[i] <= t_enter[j] {
-            (i, j)
-        } else {
-            (j, i)
-        };
-        stack.push(entry(far));
-        return Some(entry(near));
+        if t_enter[i] <= t_enter[j] {
+            stack.push(entry(j));
+            return Some(entry(i));
+        }
+        stack.push(entry(i));
+        return Some(entry(j));
     }
     let mut m = mask;
     let mut k = 0;
