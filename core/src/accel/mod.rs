@@ -10,6 +10,7 @@ mod wide;
 
 pub use bvh::{Bvh, BvhNode};
 pub use grid::{CellVisit, MAX_CELLS, MAX_ENTRIES, UniformGrid};
+pub use wide::MAX_TRIANGLES;
 
 /// A broken structural invariant of a BVH, found by `check_invariants` (a tracelab bug, not
 /// a user error): what is wrong, naming the node or primitive.

@@ -12,13 +12,43 @@ use super::sah::{self, MAX_DEPTH, MAX_LEAF};
 
 pub const WIDTH: usize = 8;
 
-/// A child reference: an inner node index, or (top bit set) a leaf of triangles
+/// A child reference: an inner node, or (top bit set) a leaf of triangles
 /// `first..first + count` with count - 1 in bits 28..31 and first in bits 0..28.
+///
+/// An inner node is named by its offset in the node array in 8-byte units (`inner`: its
+/// index times 28), which the walk's load takes as its scaled index: an index needed a
+/// multiply by 224, three cycles on the walk's critical path, node after node (single rays
+/// +1-3.5%, `docs/perf.md`). 2^31 units hold 76.7 million nodes; a tree has fewer nodes
+/// than triangles, and `MAX_TRIANGLES` is 2^26.
 pub type Child = u32;
+/// Bytes in one `Child` unit.
+pub const NODE_UNIT: usize = 8;
+/// `Child` units in one node.
+pub const NODE_UNITS: u32 = (size_of::<Node8>() / NODE_UNIT) as u32;
+const _: () = assert!(
+    size_of::<Node8>() == 224
+        && size_of::<Node8>() % NODE_UNIT == 0
+        && MAX_TRIANGLES * (NODE_UNITS as usize) < LEAF_BIT as usize
+);
+
+/// The child that names inner node `index`.
+#[inline]
+pub fn inner(index: usize) -> Child {
+    debug_assert!(index < MAX_TRIANGLES);
+    (index * NODE_UNITS as usize) as Child
+}
+
+/// The index of the inner node `c` names, if it names the start of one.
+pub fn node_index(c: Child) -> Option<usize> {
+    (!is_leaf(c) && c % NODE_UNITS == 0).then_some((c / NODE_UNITS) as usize)
+}
 const LEAF_BIT: u32 = 1 << 31;
 const FIRST_BITS: u32 = 28;
-/// Meshes up to 2^28 triangles (≈ 10 GB of geometry) are addressable in a leaf.
-pub const MAX_TRIANGLES: usize = 1 << FIRST_BITS;
+/// The most triangles a mesh may have: a leaf could address 2^28, but the nodes of a tree
+/// over more than 2^26 might not all be named by a `Child`. 2^26 triangles are 4.3 GB of
+/// tree, from an OBJ file of at least 512 MiB, the most the loader reads.
+pub const MAX_TRIANGLES: usize = 1 << 26;
+const _: () = assert!(MAX_TRIANGLES <= 1 << FIRST_BITS);
 
 #[inline]
 pub fn is_leaf(c: Child) -> bool {
@@ -236,7 +266,7 @@ fn emit(plans: &[Plan], at: usize, nodes: &mut Vec<Node8>) -> u32 {
     for (slot, &k) in slots[..used].iter().enumerate() {
         let kp = &plans[k];
         let c = match kp.how[0] {
-            How::Node { .. } => emit(plans, k, nodes),
+            How::Node { .. } => inner(emit(plans, k, nodes) as usize),
             _ => leaf(kp.first, kp.count),
         };
         nodes[me].set(slot, kp.bounds, c);
@@ -443,10 +473,12 @@ mod tests {
                         return Err(format!("node {i} slot {s} is no subtree's leaf"));
                     }
                     ranges.push(leaf_range(c));
-                } else if nodes.get(c as usize).map(Node8::bounds) != Some(b) {
-                    return Err(format!("node {i} slot {s}'s box is not its node's"));
+                } else if let Some(k) = node_index(c)
+                    && nodes.get(k).map(Node8::bounds) == Some(b)
+                {
+                    stack.push(k);
                 } else {
-                    stack.push(c as usize);
+                    return Err(format!("node {i} slot {s}'s box is not its node's"));
                 }
             }
         }
@@ -508,7 +540,7 @@ mod tests {
         assert!(check(&root, &dropped).is_err());
         // A leaf between two others in the node below: every box stays the same, only the
         // count of triangles can tell.
-        let below = nodes[0].child[inner] as usize;
+        let below = node_index(nodes[0].child[inner]).unwrap();
         let mut dropped = nodes.clone();
         dropped[below].set(3, Aabb::EMPTY, 0);
         assert_eq!(dropped[below].bounds(), nodes[below].bounds());

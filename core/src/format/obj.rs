@@ -16,6 +16,7 @@ use std::time::SystemTime;
 
 use glam::Vec3;
 
+use crate::accel::MAX_TRIANGLES;
 use crate::scene::Mesh;
 use file_kind::{FileKind, file_kind, open_regular};
 
@@ -187,6 +188,16 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, ObjError> {
 
 /// Positions and triangles of OBJ text, checked, before the BVH is built.
 fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
+    parse_obj_triangles_up_to(bytes, name, MAX_TRIANGLES)
+}
+
+/// `parse_obj_triangles` with at most `limit` triangles: a polygon of n corners is n - 2
+/// triangles, so even a file under `MAX_OBJ_BYTES` can hold more than the BVH takes.
+fn parse_obj_triangles_up_to(
+    bytes: &[u8],
+    name: &str,
+    limit: usize,
+) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), ObjError> {
     let bytes = without_bom(bytes);
     let (positions, triangles) = match fast::parse(bytes) {
         Some(r) => r,
@@ -194,6 +205,12 @@ fn parse_obj_triangles(bytes: &[u8], name: &str) -> Result<(Vec<Vec3>, Vec<[u32;
     };
     if positions.iter().any(|p| !p.is_finite()) {
         return Err(ObjError::Syntax(locate::non_finite_vertex(bytes, name)));
+    }
+    if triangles.len() > limit {
+        return Err(ObjError::TooManyTriangles {
+            count: triangles.len(),
+            limit,
+        });
     }
     Ok((positions, triangles))
 }
@@ -262,6 +279,23 @@ mod tests {
         let p = dir.join(name);
         std::fs::write(&p, text).expect("write");
         p
+    }
+
+    #[test]
+    fn a_mesh_of_more_triangles_than_the_bvh_holds_is_an_error() {
+        // A pentagon and a triangle: 4 triangles, on both readers.
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nf 1 2 3 4 5\nf 1 2 3\n";
+        let fast = parse_obj_fast(text.as_bytes()).expect("the fast reader's file");
+        assert_eq!(fast.1.len(), 4);
+        let tobj = load_with_tobj(text.as_bytes(), "fan.obj").expect("tobj reads it");
+        assert_eq!(tobj.1.len(), 4);
+        assert!(parse_obj_triangles_up_to(text.as_bytes(), "fan.obj", 4).is_ok());
+        let e = parse_obj_triangles_up_to(text.as_bytes(), "fan.obj", 3).unwrap_err();
+        assert_eq!(e, ObjError::TooManyTriangles { count: 4, limit: 3 });
+        assert_eq!(
+            e.to_string(),
+            "the mesh has 4 triangles, more than the 3 tracelab can trace"
+        );
     }
 
     #[test]

@@ -11,7 +11,8 @@ use crate::geometry::Aabb;
 
 impl TriangleBvh {
     /// Builds over the mesh. Vertex indices out of range read as the origin (the loaders
-    /// reject them); triangles beyond 2^28 are left out.
+    /// reject them); triangles beyond `wide::MAX_TRIANGLES` (2^26) are left out (the OBJ
+    /// loader refuses such meshes).
     pub fn build(positions: &[Vec3], triangles: &[[u32; 3]]) -> TriangleBvh {
         // Leaves sized for the leaf test this CPU runs: eight triangles cost one AVX test,
         // but eight scalar tests where there is no AVX.

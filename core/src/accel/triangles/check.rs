@@ -104,7 +104,10 @@ impl TriangleBvh {
                         seen[id as usize] += 1;
                     }
                 } else {
-                    stack.push((c as usize, Some(b), depth + 1));
+                    let k = wide::node_index(c).ok_or(format!(
+                        "node {i} slot {s}: child {c} names no node's start"
+                    ))?;
+                    stack.push((k, Some(b), depth + 1));
                 }
             }
             if used == 0 {

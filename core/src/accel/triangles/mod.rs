@@ -16,7 +16,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::wide::{Node8, WIDTH};
+use super::wide::{Child, NODE_UNIT, NODE_UNITS, Node8, WIDTH};
 use crate::geometry::{Aabb, moller_trumbore};
 
 #[cfg(target_arch = "x86_64")]
@@ -51,6 +51,33 @@ pub struct TriangleBvh {
     /// frame miss the mesh, and one box is far cheaper than the root's eight.
     root_lo: Vec3A,
     root_hi: Vec3A,
+}
+
+impl TriangleBvh {
+    /// The node an inner child names (`wide::inner`): the walks' step from a child to its
+    /// node, one scaled load (`Child`). Panics on a child past the last node or not on a
+    /// multiple of 32 bytes.
+    #[inline(always)]
+    fn node(&self, c: Child) -> &Node8 {
+        let units = c as usize;
+        assert!(
+            units + NODE_UNITS as usize <= self.nodes.len() * NODE_UNITS as usize
+                && (units * NODE_UNIT) % align_of::<Node8>() == 0
+        );
+        #[allow(unsafe_code)]
+        // SAFETY: the node's bytes lie inside `nodes` and start aligned for Node8 (the
+        // assert). A child that is no node's start (none is: `check` tests it) would read
+        // parts of two neighbours, initialised `f32`s and `u32`s, for which any bits are
+        // valid (Node8 has no padding).
+        unsafe {
+            &*self
+                .nodes
+                .as_ptr()
+                .cast::<u8>()
+                .add(units * NODE_UNIT)
+                .cast::<Node8>()
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

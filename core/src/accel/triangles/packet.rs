@@ -181,9 +181,10 @@ impl TriangleBvh {
                     t_far = t_best.iter().copied().fold(f32::NEG_INFINITY, f32::max);
                 }
             } else {
-                let n = &self.nodes[cur as usize];
+                let n = self.node(cur);
                 let mask = p.slab8(n, t_min, t_far, &mut t_enter);
-                let at = cur * 8;
+                // The slot's node by index (a node's unit offset times 8 could overflow).
+                let at = cur / wide::NODE_UNITS * 8;
                 let entry = |s: usize| (n.child[s], t_enter[s], at + s as u32);
                 if let Some((c, _, b)) = nearest_first(mask, &t_enter, &mut stack, entry) {
                     cur = c;

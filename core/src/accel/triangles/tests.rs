@@ -318,6 +318,26 @@ fn broken_trees_fail_the_invariant_check() {
     dup.ids[1] = dup.ids[0];
     assert!(dup.check_invariants(&pos, &tris).is_err());
     assert!(good.check_invariants(&pos, &tris[1..]).is_err());
+    // An inner child 32 bytes past its node's start: aligned, inside the array, no node's.
+    let mut shifted = good.clone();
+    let s = (0..WIDTH)
+        .find(|&s| !shifted.nodes[0].slot_is_empty(s) && !wide::is_leaf(shifted.nodes[0].child[s]))
+        .expect("a 300-triangle tree's root has an inner child");
+    shifted.nodes[0].child[s] += 4;
+    let e = shifted.check_invariants(&pos, &tris).unwrap_err();
+    assert!(e.to_string().contains("names no node's start"), "{e}");
+}
+
+#[test]
+fn a_child_past_the_last_node_panics_instead_of_reading_past_the_nodes() {
+    let (pos, tris) = random_mesh(300, 31);
+    let bvh = build_checked(&pos, &tris);
+    let last = wide::inner(bvh.nodes.len() - 1);
+    assert_eq!(bvh.node(last), bvh.nodes.last().unwrap());
+    for bad in [last + 1, last + wide::NODE_UNITS] {
+        let r = std::panic::catch_unwind(|| bvh.node(bad).child[0]);
+        assert!(r.is_err(), "child {bad} of {} nodes", bvh.nodes.len());
+    }
 }
 
 #[test]

@@ -189,7 +189,7 @@ fn closest_hit_with<const FIRST: bool>(
                 best = k;
             }
         } else {
-            let n = &bvh.nodes[cur as usize];
+            let n = bvh.node(cur);
             let mask = slab8(r, n, t_min, t_best, &mut t_enter);
             let entry = |s: usize| (n.child[s], t_enter[s]);
             if let Some((c, _)) = nearest_first(mask, &t_enter, &mut stack, entry) {
@@ -520,7 +520,7 @@ impl TriangleBvh {
                 }
                 continue;
             }
-            let n = &self.nodes[c as usize];
+            let n = self.node(c);
             let mut mask = r.slab8(n, t_min, t_max, &mut t_enter);
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;

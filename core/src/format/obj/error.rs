@@ -21,6 +21,9 @@ pub enum ObjError {
     Io(String),
     #[error("the file is larger than {limit_mib} MiB, the most tracelab reads as an OBJ mesh")]
     TooLarge { limit_mib: usize },
+    /// More triangles (after splitting polygons) than a mesh's BVH can hold.
+    #[error("the mesh has {count} triangles, more than the {limit} tracelab can trace")]
+    TooManyTriangles { count: usize, limit: usize },
     /// The text is not a mesh tracelab can use; the message names the line where it can.
     #[error("{0}")]
     Syntax(String),
