@@ -18,8 +18,9 @@ pub const WIDTH: usize = 8;
 /// An inner node is named by its offset in the node array in 8-byte units (`inner`: its
 /// index times 28), which the walk's load takes as its scaled index: an index needed a
 /// multiply by 224, three cycles on the walk's critical path, node after node (single rays
-/// +1-3.5%, `docs/perf.md`). 2^31 units hold 76.7 million nodes; a tree has fewer nodes
-/// than triangles, and `MAX_TRIANGLES` is 2^26.
+/// +1-4%, `docs/perf.md`). 2^31 units hold 76.7 million nodes; a tree has no more nodes
+/// than triangles (every node but a lone root has two children or more), and
+/// `MAX_TRIANGLES` is 2^26.
 pub type Child = u32;
 /// Bytes in one `Child` unit.
 pub const NODE_UNIT: usize = 8;
@@ -45,8 +46,9 @@ pub fn node_index(c: Child) -> Option<usize> {
 const LEAF_BIT: u32 = 1 << 31;
 const FIRST_BITS: u32 = 28;
 /// The most triangles a mesh may have: a leaf could address 2^28, but the nodes of a tree
-/// over more than 2^26 might not all be named by a `Child`. 2^26 triangles are 4.3 GB of
-/// tree, from an OBJ file of at least 512 MiB, the most the loader reads.
+/// over more than 2^26 might not all be named by a `Child`. 2^26 triangles take 4.3 GB as a
+/// tree; the OBJ loader refuses meshes of more (`ObjError::TooManyTriangles`: a file under
+/// its size limit can still hold them, a polygon of n corners being n - 2 triangles).
 pub const MAX_TRIANGLES: usize = 1 << 26;
 const _: () = assert!(MAX_TRIANGLES <= 1 << FIRST_BITS);
 

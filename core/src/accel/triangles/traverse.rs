@@ -113,6 +113,10 @@ impl<const NX: bool, const NY: bool, const NZ: bool> LeafRay for InOctant<'_, NX
 /// nearest of them pops first. One slot: itself; two: the far one pushed, no sort (the lower
 /// slot wins a tie); more: all pushed, the top insertion-sorted, the nearest popped.
 /// `entry(slot)` is what the stack holds for a slot. None when `mask` is empty.
+///
+/// Two slots take a branch on their order, not a conditional move: with the move, the next
+/// node's load waited for the two entry distances' round trip through `t_enter`, and single
+/// rays were 2-4% slower (`docs/perf.md`; one path for one slot and two, 6-10% slower).
 #[inline(always)]
 pub(super) fn nearest_first<E: StackEntry>(
     mask: u32,
