@@ -48,9 +48,6 @@ pub(super) fn load_row(row: &[Vec4; 2]) -> __m256 {
 /// The end of every 8-box slab test, from the per-axis entry and exit distances of the
 /// eight boxes: near = the latest entry or t_min, far = the earliest exit or t_far, widened
 /// by `SLAB_WIDEN`. Returns near and the mask of lanes with near <= far.
-///
-/// Operand order matters: maxps/minps return the second operand where the first is NaN (an
-/// axis-parallel ray's 0 * inf), so that axis drops out, as in the SSE test.
 #[target_feature(enable = "avx")]
 #[inline]
 pub(super) fn slab_tail(
@@ -59,6 +56,22 @@ pub(super) fn slab_tail(
     t_min: __m256,
     t_far: __m256,
 ) -> (__m256, u32) {
+    let (near, far) = near_far(entry, exit, t_min, t_far);
+    (near, widened_mask(near, far))
+}
+
+/// (near, far) of `slab_tail`, before the widening.
+///
+/// Operand order matters: maxps/minps return the second operand where the first is NaN (an
+/// axis-parallel ray's 0 * inf), so that axis drops out, as in the SSE test.
+#[target_feature(enable = "avx")]
+#[inline]
+fn near_far(
+    entry: [__m256; 3],
+    exit: [__m256; 3],
+    t_min: __m256,
+    t_far: __m256,
+) -> (__m256, __m256) {
     let near = _mm256_max_ps(
         _mm256_max_ps(entry[0], entry[1]),
         _mm256_max_ps(entry[2], t_min),
@@ -67,9 +80,15 @@ pub(super) fn slab_tail(
         _mm256_min_ps(exit[0], exit[1]),
         _mm256_min_ps(exit[2], t_far),
     );
+    (near, far)
+}
+
+/// The lanes with near <= far * `SLAB_WIDEN`.
+#[target_feature(enable = "avx")]
+#[inline]
+fn widened_mask(near: __m256, far: __m256) -> u32 {
     let far = _mm256_mul_ps(far, _mm256_set1_ps(SLAB_WIDEN));
-    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
-    (near, mask)
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
 }
 
 /// `SlabRay::slab8` in one register: the ray (origin `o`, reciprocal direction `inv`, and
@@ -96,8 +115,26 @@ pub(super) fn slab8(
     let (ny, fy) = slab(1);
     let (nz, fz) = slab(2);
     let (t_min, t_max) = (_mm256_set1_ps(t_min), _mm256_set1_ps(t_max));
-    let (near, mask) = slab_tail([nx, ny, nz], [fx, fy, fz], t_min, t_max);
+    let (near, far) = near_far([nx, ny, nz], [fx, fy, fz], t_min, t_max);
     store8(t_enter, near);
+    // The mask returned is `slab_tail`'s, near <= far * SLAB_WIDEN. near <= far is the same
+    // mask but for a box grazed within rounding, and known three cycles sooner (the
+    // multiply), which the walk waits for node after node: it goes on with that mask while
+    // the widened one checks it, a branch almost never taken. Single rays +1-3% (packets
+    // gained nothing: `docs/perf.md`).
+    let unwidened = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
+    let mask = widened_mask(near, far);
+    if unwidened != mask {
+        return grazed(mask);
+    }
+    unwidened
+}
+
+/// `slab8`'s mask where the widening changed it: out of line, so the common path keeps the
+/// unwidened mask and does not wait for the widening.
+#[cold]
+#[inline(never)]
+fn grazed(mask: u32) -> u32 {
     mask
 }
 

@@ -585,6 +585,76 @@ fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
     assert_eq!(packet(zero), None, "one ray is parallel to the xz plane");
 }
 
+/// The AVX 8-box test returns its unwidened mask early and checks it against the widened
+/// one (`avx::slab8`): where they differ, a box grazed within rounding, it must give the
+/// widened mask, the SSE test's. Rays aimed at a box's edge put near and far a few ulps
+/// apart either way; the test counts the boxes only the widening keeps, so a run that
+/// never took that branch fails instead of passing unchecked.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn the_avx_box_test_keeps_boxes_grazed_within_rounding() {
+    use glam::Vec4;
+
+    use super::avx;
+    use super::traverse::SlabRay;
+    assert!(
+        has_avx(),
+        "this test checks the AVX box test: run it on a CPU with AVX"
+    );
+    let mut rng = Rng(12345);
+    let (mut grazed, mut entered, mut missed) = (0, 0, 0);
+    for _ in 0..20_000 {
+        let lo = rng.v() * 4.0 - 2.0;
+        let hi = lo + rng.v() * 2.0 + Vec3::splat(0.01);
+        // A point on the box's edge x = hi.x, y = hi.y, and an origin off the box.
+        let edge = Vec3::new(hi.x, hi.y, lo.z + (hi.z - lo.z) * rng.f());
+        let o = Vec3A::from(rng.v() * 8.0 - 4.0 + Vec3::new(0.0, 0.0, 6.0));
+        let d = Vec3A::from(edge) - o;
+        let mut node = wide::Node8 {
+            lo: [[Vec4::INFINITY; 2]; 3],
+            hi: [[Vec4::NEG_INFINITY; 2]; 3],
+            child: [0; WIDTH],
+        };
+        for a in 0..3 {
+            node.lo[a][0][0] = lo[a];
+            node.hi[a][0][0] = hi[a];
+        }
+        let r = SlabRay::new(o, d);
+        let (mut near_sse, mut near_avx) = ([0.0; WIDTH], [0.0; WIDTH]);
+        let sse = r.slab8(&node, 0.0, f32::INFINITY, &mut near_sse);
+        #[allow(unsafe_code)]
+        // SAFETY: the CPU has AVX, checked above.
+        let avx = unsafe {
+            avx::slab8(
+                &node,
+                r.o,
+                r.inv,
+                r.toward_neg,
+                0.0,
+                f32::INFINITY,
+                &mut near_avx,
+            )
+        };
+        assert_eq!(avx, sse, "ray {o} + t {d}");
+        assert_eq!(near_avx, near_sse);
+        // Slot 0's far, as the tests compute it before widening.
+        let exit = |a: usize| {
+            let plane = if r.toward_neg[a] { lo[a] } else { hi[a] };
+            (plane - r.o[a]) * r.inv[a]
+        };
+        let far = exit(0).min(exit(1)).min(exit(2).min(f32::INFINITY));
+        match (sse & 1 != 0, near_sse[0] <= far) {
+            (true, false) => grazed += 1,
+            (true, true) => entered += 1,
+            (false, _) => missed += 1,
+        }
+    }
+    assert!(
+        grazed > 0 && entered > 0,
+        "grazed {grazed}, entered {entered}, missed {missed}"
+    );
+}
+
 /// The sparse variant gives up on packets whose rays lie far apart on a fine mesh (and only
 /// on those: a dense tile of the same camera stays a packet), with the single rays' hits.
 #[cfg(target_arch = "x86_64")]

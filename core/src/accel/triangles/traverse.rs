@@ -48,7 +48,13 @@ impl SlabRay {
     /// Entry distances of all eight slots into `t_enter`; bit i of the result is set when
     /// slot i is entered within [t_min, t_max]. Two SSE halves; `avx::slab8` is one register.
     #[inline(always)]
-    fn slab8(&self, n: &Node8, t_min: f32, t_max: f32, t_enter: &mut [f32; WIDTH]) -> u32 {
+    pub(super) fn slab8(
+        &self,
+        n: &Node8,
+        t_min: f32,
+        t_max: f32,
+        t_enter: &mut [f32; WIDTH],
+    ) -> u32 {
         let (nx, fx) = n.entry_exit(0, self.toward_neg[0]);
         let (ny, fy) = n.entry_exit(1, self.toward_neg[1]);
         let (nz, fz) = n.entry_exit(2, self.toward_neg[2]);
