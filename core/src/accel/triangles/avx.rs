@@ -131,11 +131,13 @@ pub(super) fn slab8(
 }
 
 /// `slab8`'s mask where the widening changed it: out of line, so the common path keeps the
-/// unwidened mask and does not wait for the widening.
+/// unwidened mask and does not wait for the widening. Opaque (`black_box`): returning its
+/// argument plainly, LLVM saw that both paths give the widened mask and kept only that one
+/// when the compares went to mask registers (5% slower; `docs/perf.md`).
 #[cold]
 #[inline(never)]
 fn grazed(mask: u32) -> u32 {
-    mask
+    std::hint::black_box(mask)
 }
 
 /// The call sites of the leaf tests (`leaf8`'s `CALLER`).
