@@ -28,7 +28,7 @@ pub const NODE_UNIT: usize = 8;
 pub const NODE_UNITS: u32 = (size_of::<Node8>() / NODE_UNIT) as u32;
 const _: () = assert!(
     size_of::<Node8>() == 224
-        && size_of::<Node8>() % NODE_UNIT == 0
+        && size_of::<Node8>().is_multiple_of(NODE_UNIT)
         && MAX_TRIANGLES * (NODE_UNITS as usize) < LEAF_BIT as usize
 );
 
@@ -41,7 +41,7 @@ pub fn inner(index: usize) -> Child {
 
 /// The index of the inner node `c` names, if it names the start of one.
 pub fn node_index(c: Child) -> Option<usize> {
-    (!is_leaf(c) && c % NODE_UNITS == 0).then_some((c / NODE_UNITS) as usize)
+    (!is_leaf(c) && c.is_multiple_of(NODE_UNITS)).then_some((c / NODE_UNITS) as usize)
 }
 const LEAF_BIT: u32 = 1 << 31;
 const FIRST_BITS: u32 = 28;
@@ -542,7 +542,7 @@ mod tests {
         assert!(check(&root, &dropped).is_err());
         // A leaf between two others in the node below: every box stays the same, only the
         // count of triangles can tell.
-        let below = node_index(nodes[0].child[inner]).unwrap();
+        let below = node_index(nodes[0].child[inner]).expect("an inner child names a node");
         let mut dropped = nodes.clone();
         dropped[below].set(3, Aabb::EMPTY, 0);
         assert_eq!(dropped[below].bounds(), nodes[below].bounds());

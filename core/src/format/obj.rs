@@ -290,7 +290,8 @@ mod tests {
         let tobj = load_with_tobj(text.as_bytes(), "fan.obj").expect("tobj reads it");
         assert_eq!(tobj.1.len(), 4);
         assert!(parse_obj_triangles_up_to(text.as_bytes(), "fan.obj", 4).is_ok());
-        let e = parse_obj_triangles_up_to(text.as_bytes(), "fan.obj", 3).unwrap_err();
+        let e = parse_obj_triangles_up_to(text.as_bytes(), "fan.obj", 3)
+            .expect_err("4 triangles are over a limit of 3");
         assert_eq!(e, ObjError::TooManyTriangles { count: 4, limit: 3 });
         assert_eq!(
             e.to_string(),

@@ -62,7 +62,7 @@ impl TriangleBvh {
         let units = c as usize;
         assert!(
             units + NODE_UNITS as usize <= self.nodes.len() * NODE_UNITS as usize
-                && (units * NODE_UNIT) % align_of::<Node8>() == 0
+                && (units * NODE_UNIT).is_multiple_of(align_of::<Node8>())
         );
         #[allow(unsafe_code)]
         // SAFETY: the node's bytes lie inside `nodes` and start aligned for Node8 (the
