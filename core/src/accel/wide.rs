@@ -18,7 +18,7 @@ pub const WIDTH: usize = 8;
 /// An inner node is named by its offset in the node array in 8-byte units (`inner`: its
 /// index times 28), which the walk's load takes as its scaled index: an index needed a
 /// multiply by 224, three cycles on the walk's critical path, node after node (single rays
-/// +1-4%, `docs/perf.md`). 2^31 units hold 76.7 million nodes; a tree has no more nodes
+/// +0.7-1.4%, `docs/perf.md`). 2^31 units hold 76.7 million nodes; a tree has no more nodes
 /// than triangles (every node but a lone root has two children or more), and
 /// `MAX_TRIANGLES` is 2^26.
 pub type Child = u32;

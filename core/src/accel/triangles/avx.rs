@@ -120,7 +120,7 @@ pub(super) fn slab8(
     // The mask returned is `slab_tail`'s, near <= far * SLAB_WIDEN. near <= far is the same
     // mask but for a box grazed within rounding, and known three cycles sooner (the
     // multiply), which the walk waits for node after node: it goes on with that mask while
-    // the widened one checks it, a branch almost never taken. Single rays +1-3% (packets
+    // the widened one checks it, a branch almost never taken. Single rays +2-3% (packets
     // gained nothing: `docs/perf.md`).
     let unwidened = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
     let mask = widened_mask(near, far);

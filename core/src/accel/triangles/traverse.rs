@@ -122,7 +122,7 @@ impl<const NX: bool, const NY: bool, const NZ: bool> LeafRay for InOctant<'_, NX
 ///
 /// Two slots take a branch on their order, not a conditional move: with the move, the next
 /// node's load waited for the two entry distances' round trip through `t_enter`, and single
-/// rays were 2-4% slower (`docs/perf.md`; one path for one slot and two, 6-10% slower).
+/// rays were up to 4% slower (`docs/perf.md`; one path for one slot and two: 6-10% slower).
 #[inline(always)]
 pub(super) fn nearest_first<E: StackEntry>(
     mask: u32,
