@@ -110,6 +110,21 @@ impl Node8 {
 
     /// Axis `a`'s (entry, exit) rows for a ray whose direction's sign on that axis is
     /// negative when `toward_neg`: such a ray enters through the max plane.
+    /// Slot `s`'s child, as the single-ray walks read it to go down: a volatile read, so it
+    /// stays one load from this node. With a plain read LLVM merged it with the pop's load of
+    /// a stack entry into one load from an address chosen between the two, which put that
+    /// choice's two instructions on the chain from one node to the next: single rays 1-4%
+    /// slower on Zen 5 (`docs/perf.md`). A volatile read of a valid reference is a plain load.
+    #[inline(always)]
+    pub fn child_at(&self, s: usize) -> Child {
+        let c = &self.child[s];
+        #[allow(unsafe_code)]
+        // SAFETY: `c` refers to an initialised, aligned u32 inside `self`.
+        unsafe {
+            std::ptr::read_volatile(c)
+        }
+    }
+
     #[inline(always)]
     pub fn entry_exit(&self, a: usize, toward_neg: bool) -> (&[Vec4; 2], &[Vec4; 2]) {
         if toward_neg {

@@ -201,7 +201,7 @@ fn closest_hit_with<const FIRST: bool>(
         } else {
             let n = bvh.node(cur);
             let mask = slab8(r, n, t_min, t_best, &mut t_enter);
-            let entry = |s: usize| (n.child[s], t_enter[s]);
+            let entry = |s: usize| (n.child_at(s), t_enter[s]);
             if let Some((c, _)) = nearest_first(mask, &t_enter, &mut stack, entry) {
                 cur = c;
                 continue;
