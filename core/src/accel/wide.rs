@@ -66,7 +66,7 @@ pub fn leaf_range(c: Child) -> (usize, usize) {
     )
 }
 
-fn leaf(first: u32, count: u32) -> Child {
+pub fn leaf(first: u32, count: u32) -> Child {
     debug_assert!(count >= 1 && count as usize <= MAX_LEAF && (first as usize) < MAX_TRIANGLES);
     LEAF_BIT | ((count - 1) << FIRST_BITS) | first
 }

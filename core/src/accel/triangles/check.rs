@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::{TriangleBvh, soa_len};
+use super::{FLAT_MAX, TriangleBvh, soa_len};
 use crate::accel::sah;
 use crate::accel::wide::{self, WIDTH};
 use crate::geometry::Aabb;
@@ -12,6 +12,13 @@ impl TriangleBvh {
     /// Shape of the tree, for `tracelab bench`: nodes, mean children per node, leaves and
     /// mean triangles per leaf.
     pub fn shape(&self) -> String {
+        if self.nodes.is_empty() && !self.is_empty() {
+            return format!(
+                "flat: no nodes, {} leaves, {} triangles",
+                self.stride.div_ceil(WIDTH),
+                self.stride
+            );
+        }
         let (mut slots, mut leaves) = (0usize, 0usize);
         for n in &self.nodes {
             for s in 0..WIDTH {
@@ -32,7 +39,7 @@ impl TriangleBvh {
     }
 
     /// Checks the BVH invariants against the mesh it was built from (for tests): every
-    /// triangle in exactly one leaf, every leaf box around its triangles, every node's boxes
+    /// triangle in exactly one leaf (a flat mesh: in the root's box, at most `FLAT_MAX`), every leaf box around its triangles, every node's boxes
     /// inside the box its parent holds for it, each node reached once, depth within the cap.
     pub fn check_invariants(
         &self,
@@ -64,9 +71,28 @@ impl TriangleBvh {
             ));
         }
         let mut seen = vec![0u32; triangles.len()];
+        if self.nodes.is_empty() {
+            // Flat: few triangles, all in the root's box (the walks test them all).
+            if triangles.len() > FLAT_MAX {
+                return Err(format!("no nodes over {} triangles", triangles.len()));
+            }
+            for &id in &self.ids {
+                let t = triangles
+                    .get(id as usize)
+                    .ok_or(format!("bad triangle id {id}"))?;
+                if !self.bounds().contains(&tri_box(t)) {
+                    return Err(format!("the root box does not contain triangle {id}"));
+                }
+                seen[id as usize] += 1;
+            }
+        }
         let mut reached = vec![0u32; self.nodes.len()];
-        // (node, the box its parent holds for it, depth)
-        let mut stack = vec![(0usize, None::<Aabb>, 0usize)];
+        // (node, the box its parent holds for it, depth); none in a flat mesh.
+        let mut stack = if self.nodes.is_empty() {
+            Vec::new()
+        } else {
+            vec![(0usize, None::<Aabb>, 0usize)]
+        };
         while let Some((i, parent_box, depth)) = stack.pop() {
             let n = self.nodes.get(i).ok_or(format!("node {i} out of range"))?;
             reached[i] += 1;

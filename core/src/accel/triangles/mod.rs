@@ -16,7 +16,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::wide::{Child, NODE_UNIT, NODE_UNITS, Node8, WIDTH};
+use super::wide::{self, Child, NODE_UNIT, NODE_UNITS, Node8, RayStack, StackEntry, WIDTH};
 use crate::geometry::{Aabb, moller_trumbore};
 
 #[cfg(target_arch = "x86_64")]
@@ -30,6 +30,12 @@ mod packet;
 mod tests;
 mod traverse;
 
+/// Meshes of at most this many triangles are flat: no nodes, their triangles tested after
+/// the root box as leaves of up to eight (two tests at most), in mesh order. For the
+/// 12-triangle cube the one node was 224 of 972 bytes (81 bytes a triangle, over issue 32's
+/// 68); without it single rays trace as fast, packets 5% slower (`docs/perf.md`).
+const FLAT_MAX: usize = 2 * WIDTH;
+
 /// What a box's exit distance is multiplied by before the `near <= far` test, so rounding
 /// never culls a box the ray touches: 1 + 2γ₃ (Ize, "Robust BVH Ray Traversal", 2013), where
 /// γ₃ = 3u/(1 − 3u) with u = 2⁻²⁴ bounds the relative error of three roundings (the
@@ -39,6 +45,8 @@ const SLAB_WIDEN: f32 = 1.000_000_4;
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleBvh {
+    /// Node 0 is the root. None for an empty mesh, and none for a flat one (at most
+    /// `FLAT_MAX` triangles), whose leaves a walk starts from (`start`).
     nodes: Vec<Node8>,
     /// Triangles in leaf order, one array per component (v0.x, v0.y, v0.z, e1.x, ... e2.z,
     /// each `stride` = triangle count long), so a leaf's up to eight triangles load as one
@@ -80,6 +88,32 @@ impl TriangleBvh {
     }
 }
 
+impl TriangleBvh {
+    /// Where every walk starts, after the root box test of a non-empty mesh: the root node,
+    /// or a flat mesh's first leaf, with its other leaves pushed (as `entry(leaf)`, entered
+    /// at the walk's t_min) so that they pop in order after it.
+    #[inline(always)]
+    fn start<E: StackEntry>(&self, stack: &mut RayStack<E>, entry: impl Fn(Child) -> E) -> Child {
+        if !self.nodes.is_empty() {
+            return 0;
+        }
+        let n = self.stride;
+        let leaf = |k: usize| wide::leaf(k as u32, (n - k).min(WIDTH) as u32);
+        let mut k = n.saturating_sub(1) / WIDTH * WIDTH;
+        while k > 0 {
+            stack.push(entry(leaf(k)));
+            k -= WIDTH;
+        }
+        leaf(0)
+    }
+
+    /// Whether the mesh has no triangles.
+    #[inline(always)]
+    fn is_empty(&self) -> bool {
+        self.stride == 0
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
     pub t: f32,
@@ -106,7 +140,10 @@ impl Tri {
 
 impl TriangleBvh {
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, Node8::bounds)
+        if self.is_empty() {
+            return Aabb::EMPTY;
+        }
+        Aabb::new(self.root_lo.into(), self.root_hi.into())
     }
 
     /// Bytes held by the nodes and the triangle copies.

@@ -112,7 +112,7 @@ impl TriangleBvh {
         sparse: bool,
     ) -> [Option<TriangleHit>; WIDTH] {
         let mut out = [None; WIDTH];
-        if self.nodes.is_empty() || active == 0 {
+        if self.is_empty() || active == 0 {
             return out;
         }
         let Some((p, live)) = PacketBounds::new(o, d, active, self, t_min, t_max) else {
@@ -132,9 +132,9 @@ impl TriangleBvh {
         let mut best = [usize::MAX; WIDTH];
         let mut stack: RayStack<(Child, f32, u32)> = RayStack::new();
         let mut t_enter = [0.0f32; WIDTH];
-        let mut cur: Child = 0;
-        // Where cur's box is stored (node * 8 + slot); unused for the root, never a leaf
-        // except in a one-slot root, whose box is the root's box.
+        // Where cur's box is stored (node * 8 + slot); none (u32::MAX) for the root and for
+        // a flat mesh's leaves, whose box is the root's, or a one-slot root's leaf.
+        let mut cur: Child = self.start(&mut stack, |c| (c, t_min, u32::MAX));
         let mut cur_box = u32::MAX;
         let (mut leaves, mut leaf_rays) = (0u32, 0u32);
         loop {

@@ -961,3 +961,58 @@ fn rays_exactly_on_edges_agree_on_every_path_and_both_sides() {
         assert_eq!(hit(a), hit(b), "{:?}", a.origin);
     }
 }
+
+/// A mesh of at most `FLAT_MAX` (16) triangles has no nodes, one more has a tree, and every walk
+/// agrees with brute force on both (closest hits on every instruction set, any hit, every
+/// hit, packets), for both leaf sizings: the walks start from a flat mesh's leaves.
+#[test]
+fn small_meshes_are_flat_and_every_walk_agrees() {
+    let mut hits = 0;
+    for n in [1, 5, 6, 7, 10, 13, 14, 15, 22] {
+        // `random_mesh` adds two degenerate triangles: 3 to 24 in all, 16 and 17 among them.
+        let (pos, tris) = random_mesh(n, 40 + n as u32);
+        let mut r = Rng(7 + n as u32);
+        // Rays from all around at points of the triangles, and some at nothing.
+        let rays: Vec<Ray> = (0..400)
+            .map(|i| {
+                let [a, b, c] = tris[i % tris.len()].map(|v| pos[v as usize]);
+                let (u, v) = (r.f() * 0.5, r.f() * 0.5);
+                let target = a + (b - a) * u + (c - a) * v + (r.v() - 0.5) * 0.2;
+                let o = (r.v() * 2.0 - 1.0) * 8.0;
+                Ray::new(o, target - o)
+            })
+            .collect();
+        for block in [1, WIDTH as u32] {
+            let bvh = TriangleBvh::build_with(&pos, &tris, sah::LeafBlock(block));
+            bvh.check_invariants(&pos, &tris)
+                .unwrap_or_else(|e| panic!("{} triangles, block {block}: {e}", tris.len()));
+            // Up to 16: two leaf tests, the 12-triangle cube among them.
+            assert_eq!(
+                bvh.nodes.is_empty(),
+                tris.len() <= 16,
+                "{} triangles: {}",
+                tris.len(),
+                bvh.shape()
+            );
+            assert_agrees(&pos, &tris, &bvh, &rays);
+            hits += assert_any_hit_agrees(&bvh, &rays, 0.0).1;
+            let mut out = Vec::new();
+            for (k, ray) in rays.iter().enumerate() {
+                out.clear();
+                bvh.intersect_all(ray, 0.0, f32::INFINITY, &mut out);
+                let mut got: Vec<u32> = out.iter().map(|h| h.triangle).collect();
+                got.sort_unstable();
+                let want: Vec<u32> = (0..tris.len() as u32)
+                    .filter(|&i| {
+                        let [a, b, c] = tris[i as usize].map(|v| pos[v as usize]);
+                        intersect_triangle(ray, a, b, c, 0.0, f32::INFINITY).is_some()
+                    })
+                    .collect();
+                assert_eq!(got, want, "{} triangles, ray {k}", tris.len());
+            }
+            let tiles = pinhole_tiles(Vec3::new(0.3, -0.2, 7.0), Vec3::ZERO, 16, 0.9);
+            assert_packets_agree(&bvh, &tiles, 0.0, &MASKS);
+        }
+    }
+    assert!(hits > 1000, "{hits} rays hit");
+}

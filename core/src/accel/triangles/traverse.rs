@@ -177,14 +177,14 @@ fn closest_hit_with<const FIRST: bool>(
     slab8: impl Fn(&SlabRay, &Node8, f32, f32, &mut [f32; WIDTH]) -> u32,
     leaf: impl Fn(&SlabRay, usize, usize, f32, f32) -> Option<(f32, usize)>,
 ) -> Option<TriangleHit> {
-    if bvh.nodes.is_empty() || !r.enters(bvh.root_lo, bvh.root_hi, t_min, t_max) {
+    if bvh.is_empty() || !r.enters(bvh.root_lo, bvh.root_hi, t_min, t_max) {
         return None;
     }
     let mut t_best = t_max;
     let mut best = usize::MAX;
     let mut stack = RayStack::new();
     let mut t_enter = [0.0f32; WIDTH];
-    let mut cur: Child = 0;
+    let mut cur: Child = bvh.start(&mut stack, |c| (c, t_min));
     loop {
         if wide::is_leaf(cur) {
             let (first, count) = wide::leaf_range(cur);
@@ -504,7 +504,7 @@ impl TriangleBvh {
     /// Every hit with t in (t_min, t_max), in no particular order, appended to `out`. CSG
     /// needs all crossings of a closed mesh along a ray, not just the nearest.
     pub fn intersect_all(&self, ray: &Ray, t_min: f32, t_max: f32, out: &mut Vec<TriangleHit>) {
-        if self.nodes.is_empty() {
+        if self.is_empty() {
             return;
         }
         if !finite_ray(ray.origin.into(), ray.direction.into()) {
@@ -513,7 +513,8 @@ impl TriangleBvh {
         let r = SlabRay::new(ray.origin.into(), ray.direction.into());
         let mut stack = RayStack::new();
         let mut t_enter = [0.0f32; WIDTH];
-        stack.push((0, t_min));
+        let first = self.start(&mut stack, |c| (c, t_min));
+        stack.push((first, t_min));
         while let Some((c, _)) = stack.pop() {
             if wide::is_leaf(c) {
                 let (first, count) = wide::leaf_range(c);
