@@ -113,8 +113,9 @@ impl Node8 {
     /// Slot `s`'s child, as the single-ray walks read it to go down: a volatile read, so it
     /// stays one load from this node. With a plain read LLVM merged it with the pop's load of
     /// a stack entry into one load from an address chosen between the two, which put that
-    /// choice's two instructions on the chain from one node to the next: single rays 1-4%
-    /// slower on Zen 5 (`docs/perf.md`). A volatile read of a valid reference is a plain load.
+    /// choice's two instructions on the chain from one node to the next: single rays 1-2%
+    /// slower on the Stanford bunny on Zen 5 (`docs/perf.md`). A volatile read of a valid
+    /// reference is a plain load.
     #[inline(always)]
     pub fn child_at(&self, s: usize) -> Child {
         let c = &self.child[s];
