@@ -108,8 +108,6 @@ impl Node8 {
             .fold(Aabb::EMPTY, |b, i| b.union(self.slot_bounds(i)))
     }
 
-    /// Axis `a`'s (entry, exit) rows for a ray whose direction's sign on that axis is
-    /// negative when `toward_neg`: such a ray enters through the max plane.
     /// Slot `s`'s child, as the single-ray walks read it to go down: a volatile read, so it
     /// stays one load from this node. With a plain read LLVM merged it with the pop's load of
     /// a stack entry into one load from an address chosen between the two, which put that
@@ -126,6 +124,8 @@ impl Node8 {
         }
     }
 
+    /// Axis `a`'s (entry, exit) rows for a ray whose direction's sign on that axis is
+    /// negative when `toward_neg`: such a ray enters through the max plane.
     #[inline(always)]
     pub fn entry_exit(&self, a: usize, toward_neg: bool) -> (&[Vec4; 2], &[Vec4; 2]) {
         if toward_neg {

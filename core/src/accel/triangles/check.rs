@@ -39,8 +39,9 @@ impl TriangleBvh {
     }
 
     /// Checks the BVH invariants against the mesh it was built from (for tests): every
-    /// triangle in exactly one leaf (a flat mesh: in the root's box, at most `FLAT_MAX`), every leaf box around its triangles, every node's boxes
-    /// inside the box its parent holds for it, each node reached once, depth within the cap.
+    /// triangle in exactly one leaf, every leaf box around its triangles, every node's boxes
+    /// inside the box its parent holds for it, each node reached once, depth within the cap;
+    /// a flat mesh: at most `FLAT_MAX` triangles, each once, all in the root's box.
     pub fn check_invariants(
         &self,
         positions: &[Vec3],

@@ -89,9 +89,9 @@ impl TriangleBvh {
 }
 
 impl TriangleBvh {
-    /// Where every walk starts, after the root box test of a non-empty mesh: the root node,
-    /// or a flat mesh's first leaf, with its other leaves pushed (as `entry(leaf)`, entered
-    /// at the walk's t_min) so that they pop in order after it.
+    /// Where every walk of a non-empty mesh starts: the root node, or a flat mesh's first
+    /// leaf, with its other leaves pushed (as `entry(leaf)`, entered at the walk's t_min) so
+    /// that they pop in order after it.
     #[inline(always)]
     fn start<E: StackEntry>(&self, stack: &mut RayStack<E>, entry: impl Fn(Child) -> E) -> Child {
         if !self.nodes.is_empty() {
