@@ -552,19 +552,24 @@ fn packets_agree_with_single_rays_on_random_meshes() {
     }
 }
 
+/// For tests that call the AVX kernels directly: every CPU the project runs on has AVX, and
+/// one without fails here rather than passing without checking anything. The CPU's AVX, not
+/// `TRACELAB_SIMD`'s, so they also run when that narrows the kernels.
+#[cfg(target_arch = "x86_64")]
+fn assert_cpu_has_avx(what: &str) {
+    assert!(
+        crate::simd::detected() >= crate::simd::Level::Avx,
+        "this test checks {what}: run it on a CPU with AVX"
+    );
+}
+
 /// Pins the guard the result tests cannot see (without it, loose bounds only slow the
 /// traversal down): a packet whose rays meeting the mesh differ in direction sign on an
 /// axis, or have a zero direction component, is not traced as a packet.
 #[cfg(target_arch = "x86_64")]
 #[test]
 fn packets_with_mixed_signs_or_zero_components_go_one_by_one() {
-    // Every CPU the project runs on has AVX; one without fails here rather than passing
-    // without checking anything. The CPU's, not `TRACELAB_SIMD`'s: the AVX code is called
-    // directly.
-    assert!(
-        crate::simd::detected() >= crate::simd::Level::Avx,
-        "this test checks the AVX packet path: run it on a CPU with AVX"
-    );
+    assert_cpu_has_avx("the AVX packet path");
     let (pos, tris) = random_mesh(200, 3);
     let bvh = build_checked(&pos, &tris);
     let eye = Vec3::new(0.0, 0.0, 6.0);
@@ -600,11 +605,7 @@ fn the_avx_box_test_keeps_boxes_grazed_within_rounding() {
 
     use super::avx;
     use super::traverse::SlabRay;
-    // The CPU's AVX, not `TRACELAB_SIMD`'s: `avx::slab8` is called directly.
-    assert!(
-        crate::simd::detected() >= crate::simd::Level::Avx,
-        "this test checks the AVX box test: run it on a CPU with AVX"
-    );
+    assert_cpu_has_avx("the AVX box test");
     let mut rng = Rng(12345);
     let (mut grazed, mut entered, mut missed) = (0, 0, 0);
     for _ in 0..20_000 {
