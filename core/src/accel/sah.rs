@@ -202,12 +202,14 @@ impl Binner {
     /// (`left_of`); the tests check both against this.
     #[cfg(test)]
     fn bin(&self, p: &PrimRef, axis: usize) -> usize {
-        (((p.lo[axis] + p.hi[axis] - self.lo[axis]) * self.scale[axis]) as usize).min(self.count - 1)
+        (((p.lo[axis] + p.hi[axis] - self.lo[axis]) * self.scale[axis]) as usize)
+            .min(self.count - 1)
     }
     /// Whether `p` is in bin `split` or before on `axis`: `bin(..) <= split` without the
     /// saturating cast. For x ≥ 0, trunc(x) ≤ split exactly when x < split + 1; negatives
     /// and NaN (bin 0) answer true, +∞ (the last bin, past any split) false.
     #[inline(always)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must answer true: `!(x >= ..)` does.
     fn left_of(&self, p: &PrimRef, axis: usize, split: usize) -> bool {
         let x = (p.lo[axis] + p.hi[axis] - self.lo[axis]) * self.scale[axis];
         !(x >= (split + 1) as f32)
@@ -406,7 +408,16 @@ mod tests {
     /// Coordinates that probe the casts and comparisons: NaN, infinities, negatives, the
     /// bins' edges and the floats on each side of them, huge values.
     fn awkward() -> Vec<f32> {
-        let mut v = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.0, 0.0, -1.0, 1e30, -1e30];
+        let mut v = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            0.0,
+            -1.0,
+            1e30,
+            -1e30,
+        ];
         for k in 0..=17 {
             let x = k as f32 * 0.0625;
             v.extend([x, x.next_up(), x.next_down()]);
@@ -431,11 +442,15 @@ mod tests {
             let (lo, hi) = p.corners();
             let f = (lo + hi - Vec3A::from(binner.lo)) * Vec3A::from(binner.scale);
             let k = bins3(f, (binner.count - 1) as f32);
-            for a in 0..3 {
+            for (a, &got) in k.iter().enumerate() {
                 let want = binner.bin(&p, a);
-                assert_eq!(k[a], want, "bins3 at {:?}, axis {a}", (x, y, z));
+                assert_eq!(got, want, "bins3 at {:?}, axis {a}", (x, y, z));
                 for split in 0..binner.count - 1 {
-                    assert_eq!(binner.left_of(&p, a, split), want <= split, "{x} {a} {split}");
+                    assert_eq!(
+                        binner.left_of(&p, a, split),
+                        want <= split,
+                        "{x} {a} {split}"
+                    );
                 }
                 seen |= 1 << want;
             }
@@ -452,14 +467,28 @@ mod tests {
             let y = xs[(i * 3 + 1) % xs.len()];
             let p = Vec3::new(x, y, xs[(i * 13 + 2) % xs.len()]);
             let q = Vec3::new(y, x, xs[(i * 17 + 5) % xs.len()]);
-            let (pa, pb) = (Aabb::new(p, q), Box3 { lo: p.into(), hi: q.into() });
+            let (pa, pb) = (
+                Aabb::new(p, q),
+                Box3 {
+                    lo: p.into(),
+                    hi: q.into(),
+                },
+            );
             a = a.union(pa);
             b = b.union(pb);
             let bits = |v: Vec3| v.to_array().map(f32::to_bits);
             assert_eq!(bits(b.aabb().min), bits(a.min), "min after {i}");
             assert_eq!(bits(b.aabb().max), bits(a.max), "max after {i}");
-            assert_eq!(pb.surface_area().to_bits(), pa.surface_area().to_bits(), "{pa:?}");
-            assert_eq!(b.surface_area().to_bits(), a.surface_area().to_bits(), "{a:?}");
+            assert_eq!(
+                pb.surface_area().to_bits(),
+                pa.surface_area().to_bits(),
+                "{pa:?}"
+            );
+            assert_eq!(
+                b.surface_area().to_bits(),
+                a.surface_area().to_bits(),
+                "{a:?}"
+            );
         }
     }
 }
