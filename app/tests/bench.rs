@@ -274,3 +274,43 @@ fn repeat_threads_and_orbit_beyond_their_caps_are_usage_errors() {
         "{help}"
     );
 }
+
+/// The "median … ms of N" count on bench's frame line.
+fn frames_timed(out: &str) -> usize {
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("frame:"))
+        .unwrap_or_else(|| panic!("no frame line in {out}"));
+    let after = line
+        .split(" ms of ")
+        .nth(1)
+        .expect("\"ms of\" on the frame line");
+    after
+        .split(',')
+        .next()
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no frame count in {line:?}"))
+}
+
+#[test]
+fn short_frames_are_timed_for_a_quarter_second_and_long_runs_as_asked() {
+    let d = quad_scene("window");
+    // A 2x2 image's frames take microseconds: one asked for, many timed (0.25 s of them, at
+    // most 10,000), so a stall of the machine cannot make the median.
+    let o = tracelab(
+        &["bench", "quad.txt", "--size", "2", "2", "--repeat", "1"],
+        &d,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let n = frames_timed(&out);
+    assert!(n > 1 && n <= 10_000, "{n} frames timed:\n{out}");
+    // More frames asked for than the window needs: exactly those (the control: the count is
+    // the frames timed, not a constant).
+    let o = tracelab(
+        &["bench", "quad.txt", "--size", "2", "2", "--repeat", "12000"],
+        &d,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(frames_timed(&String::from_utf8_lossy(&o.stdout)), 12_000);
+}

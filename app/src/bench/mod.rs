@@ -60,7 +60,8 @@ pub struct BenchArgs {
     /// Threads, at most 1024.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = threads)]
     pub threads: usize,
-    /// Timed frames after a warm-up, at most 1000000.
+    /// Timed frames after a warm-up, at most 1000000; more (up to 10000) until they have taken
+    /// 0.25 s, so that a short frame's median outlasts a stall of the shared machine.
     #[arg(long, default_value_t = 5, allow_negative_numbers = true, value_parser = repeat)]
     pub repeat: usize,
     /// Trace 4x2 pixel tiles as 8-ray packets (as Embree's rtcIntersect8 loop does).
