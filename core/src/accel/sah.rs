@@ -108,9 +108,11 @@ fn extents(prims: &[PrimRef]) -> (Aabb, Aabb) {
 }
 
 /// A box as two 16-byte vectors: a union is two SSE instructions where `Aabb`'s `Vec3`s take
-/// six scalar ones (binning is most of a build). Bit for bit `Aabb`'s results, NaN included:
-/// SSE's min and max pick as glam's scalar `Vec3` does (the first operand only if it is
-/// smaller, or larger), and the operands are in `Aabb`'s order, so the trees are the same.
+/// six scalar ones (binning is most of a build). Bit for bit `Aabb`'s results on x86-64, NaN
+/// included: SSE's min and max pick as glam's scalar `Vec3` does (the first operand only if
+/// it is smaller, or larger), and the operands are in `Aabb`'s order, so the trees are the
+/// same. (Elsewhere glam's `Vec3A` may order a NaN differently: only boxes with NaN corners,
+/// which the loaders refuse, would build other trees.)
 #[derive(Clone, Copy, Debug)]
 struct Box3 {
     lo: Vec3A,
@@ -459,6 +461,10 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(
+        not(target_arch = "x86_64"),
+        ignore = "NaN order of glam's Vec3A min and max is SSE's only on x86-64"
+    )]
     fn box3_is_aabb_bit_for_bit_nan_included() {
         let xs = awkward();
         let mut a = Aabb::EMPTY;
