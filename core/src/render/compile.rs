@@ -407,13 +407,12 @@ impl CompiledScene {
         }
     }
 
-    /// A mesh instance's closest hit: the ray to object space (as `Vec3`s, whose components
-    /// the matrix product reads one at a time), then the mesh BVH, which takes 16-byte vectors.
+    /// A mesh instance's closest hit: the ray to object space, then the mesh BVH, the move
+    /// compiled into the BVH's walk (`TriangleBvh::closest_hit_of`).
     #[inline(always)]
     fn mesh_hit(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
-        let (org, dir) = o.object_ray(ray);
         m.accel
-            .closest_hit(org, dir, t_min, t_max)
+            .closest_hit_of(ray, |r| o.object_ray(r), t_min, t_max)
             .map(|h| (h.t, h.triangle))
     }
 

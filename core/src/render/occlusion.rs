@@ -61,8 +61,7 @@ impl CompiledScene {
 /// to object space by the very operations `mesh_hit` uses, so the mesh sees the same bits.
 #[inline]
 fn mesh_occludes(o: &Object, m: &Mesh, ray: &Ray, t_min: f32, t_max: f32) -> bool {
-    let (org, dir) = o.object_ray(ray);
-    m.accel.any_hit(org, dir, t_min, t_max)
+    m.accel.any_hit_of(ray, |r| o.object_ray(r), t_min, t_max)
 }
 
 #[cfg(test)]

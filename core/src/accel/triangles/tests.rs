@@ -83,7 +83,12 @@ fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX.
             let avx = unsafe {
-                bvh.closest_hit_avx(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY)
+                bvh.closest_hit_avx(
+                    ray,
+                    |r| (r.origin.into(), r.direction.into()),
+                    0.0,
+                    f32::INFINITY,
+                )
             };
             assert_eq!(a, avx, "ray {k}, avx");
         }
@@ -389,6 +394,20 @@ fn non_finite_rays_miss_and_return() {
         for (o, d) in rays {
             hits += bvh.intersect(&Ray::new(o, d), 0.0, f32::INFINITY).is_some() as usize;
             bvh.intersect_all(&Ray::new(o, d), 0.0, f32::INFINITY, &mut all);
+            // Every walk checks the ray itself (the check is in the walk, after the move
+            // into object space that `closest_hit_of` inlines), on every instruction set.
+            let (o, d) = (Vec3A::from(o), Vec3A::from(d));
+            let inf = f32::INFINITY;
+            hits += bvh.any_hit(o, d, 0.0, inf) as usize;
+            hits += bvh.closest_hit_portable(o, d, 0.0, inf).is_some() as usize;
+            hits += bvh.any_hit_portable(o, d, 0.0, inf) as usize;
+            #[cfg(target_arch = "x86_64")]
+            if crate::simd::detected() >= crate::simd::Level::Avx {
+                #[allow(unsafe_code)]
+                // SAFETY: the CPU has AVX.
+                let avx = unsafe { bvh.closest_hit_avx(&(o, d), |&r| r, 0.0, inf) };
+                hits += avx.is_some() as usize;
+            }
         }
         let _ = tx.send((hits, all.len()));
     });
