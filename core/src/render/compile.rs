@@ -242,8 +242,11 @@ impl CompiledScene {
     ///
     /// Inlined into the caller's pixel loop together with `mesh_hit`, so a one-mesh scene's
     /// ray goes from the registers it was made in to object space without a trip through
-    /// memory, where each hop was a failed store forward (docs/perf.md).
-    #[inline]
+    /// memory, where each hop was a failed store forward (docs/perf.md). Always: with
+    /// `#[inline]` LLVM kept it a call from `tracelab bench`'s loop, whose frame set-up and
+    /// return each ray paid after its walk's last, mispredicted branch (single rays 1.5-11%
+    /// slower on Zen 5, docs/perf.md).
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
         if let Some(g) = &self.grid {
             return self.intersect_grid(g, ray, t_min, t_max);
