@@ -53,23 +53,26 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
     let frame = |buf: &mut Vec<f32>| {
         // The columns' share of every ray, once per frame (bit-identical to `pixel_ray`).
         let rays = compiled.camera.pixel_rays(w, h);
-        // One row buffer per rayon job, jobs of at least 16 rows: a fresh buffer per stolen
-        // row cost 2-thread scaling (docs/perf.md, "Figures behind the code's comments").
-        let new_buf = || Vec::with_capacity(w as usize);
+        // Jobs of at most `ROWS_PER_JOB` rows, each with one row buffer (made per job, not
+        // per row: docs/perf.md, "Figures behind the code's comments"). Embree's and
+        // tinybvh's benches hand out single rows.
         buf.par_chunks_mut(w as usize)
             .enumerate()
-            .with_min_len(16)
-            .for_each_init(new_buf, |row_buf, (row, out)| {
-                // The row's rays first, in one tight loop, then the traversals: made between
-                // two traversals, each ray's set-up headed its own dependency chain
-                // (docs/perf.md).
-                rays.row(row as u32).fill(row_buf);
-                for (ray, t) in row_buf.iter().zip(out.iter_mut()) {
-                    *t = compiled
-                        .intersect(ray, t_min, f32::INFINITY)
-                        .map_or(f32::INFINITY, |hit| hit.t);
-                }
-            });
+            .with_max_len(ROWS_PER_JOB)
+            .for_each_init(
+                || Vec::with_capacity(w as usize),
+                |row_buf, (row, out)| {
+                    // The row's rays first, in one tight loop, then the traversals: made
+                    // between two traversals, each ray's set-up headed its own dependency
+                    // chain (docs/perf.md).
+                    rays.row(row as u32).fill(row_buf);
+                    for (ray, t) in row_buf.iter().zip(out.iter_mut()) {
+                        *t = compiled
+                            .intersect(ray, t_min, f32::INFINITY)
+                            .map_or(f32::INFINITY, |hit| hit.t);
+                    }
+                },
+            );
     };
     // --packets: 4x2 pixel tiles traced as 8-ray packets, as embree_bench's rtcIntersect8
     // loop does; the same rays (two rows made as above), the same t per pixel.
@@ -167,6 +170,12 @@ pub fn run(b: &BenchArgs) -> anyhow::Result<()> {
     out!("BENCH mrays_per_s={mrays:.3} hits={hits} sum_t={sum_t:.6} build_ms={build_ms:.3}{mode}");
     Ok(())
 }
+
+/// The most rows in one job of the single-ray frame. With jobs of at least 16 rows (rayon then
+/// splits a frame into a few long jobs and balances them only by stealing), 2-thread frames
+/// of the Stanford bunny were 7% slower, the other meshes' 1-3%; 1-thread frames even
+/// (docs/perf.md).
+const ROWS_PER_JOB: usize = 8;
 
 /// The least time the timed frames take, more frames than `--repeat` asks if need be.
 const MIN_TIMED: Duration = Duration::from_millis(250);
