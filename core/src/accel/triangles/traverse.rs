@@ -228,6 +228,7 @@ impl TriangleBvh {
     pub fn intersect(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<TriangleHit> {
         self.closest_hit(ray.origin.into(), ray.direction.into(), t_min, t_max)
     }
+
     /// `intersect` for a ray given as 16-byte vectors, the form the traversal keeps. Callers
     /// that build the ray just before should pass the move instead (`closest_hit_of`).
     #[inline]
