@@ -96,14 +96,20 @@ impl LeafRay for SlabRay {
 }
 
 /// A `SlabRay` in the octant of direction signs `NX`, `NY`, `NZ` (true: toward -axis), as
-/// the leaf tests read it: the same ray, a type per octant, so that each octant's walk
-/// (`TriangleBvh::by_octant`) has its own copy of the leaf test to inline. With eight walks
-/// calling one copy, LLVM left it a call, and the walks spilled their registers around it.
+/// the leaf tests read it: the same ray, a type per octant and per caller `M` (the walk's
+/// ray type and move, `closest_hit_of`), so that each octant's walk (`TriangleBvh::
+/// by_octant`) in each copy of the walk has its own copy of the leaf test to inline. With
+/// eight walks calling one copy, LLVM left it a call, and the walks spilled their registers
+/// around it; without `M`, two copies of the walk (two moves) shared the leaf tests, and
+/// left them calls again (the editor's Whitted frames up to 5% slower, `docs/perf.md`).
 #[cfg(target_arch = "x86_64")]
-struct InOctant<'a, const NX: bool, const NY: bool, const NZ: bool>(&'a SlabRay);
+struct InOctant<'a, M, const NX: bool, const NY: bool, const NZ: bool>(
+    &'a SlabRay,
+    std::marker::PhantomData<fn() -> M>,
+);
 
 #[cfg(target_arch = "x86_64")]
-impl<const NX: bool, const NY: bool, const NZ: bool> LeafRay for InOctant<'_, NX, NY, NZ> {
+impl<M, const NX: bool, const NY: bool, const NZ: bool> LeafRay for InOctant<'_, M, NX, NY, NZ> {
     #[inline(always)]
     fn origin(&self) -> Vec3A {
         self.0.o
@@ -290,10 +296,10 @@ impl TriangleBvh {
     /// triangles in one test.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    pub(super) fn closest_hit_avx<R>(
+    pub(super) fn closest_hit_avx<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
-        to_object: impl Fn(&R) -> (Vec3A, Vec3A),
+        to_object: F,
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
@@ -302,7 +308,7 @@ impl TriangleBvh {
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX, what `by_octant` needs.
         unsafe {
-            self.by_octant::<false, false>(&r, t_min, t_max)
+            self.by_octant::<(R, F), false, false>(&r, t_min, t_max)
         }
     }
 
@@ -312,10 +318,10 @@ impl TriangleBvh {
     /// faster than it on the bunnies (`docs/perf.md`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
-    pub(super) fn closest_hit_avx512<R>(
+    pub(super) fn closest_hit_avx512<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
-        to_object: impl Fn(&R) -> (Vec3A, Vec3A),
+        to_object: F,
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
@@ -324,7 +330,7 @@ impl TriangleBvh {
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
         unsafe {
-            self.by_octant::<false, true>(&r, t_min, t_max)
+            self.by_octant::<(R, F), false, true>(&r, t_min, t_max)
         }
     }
 
@@ -379,10 +385,10 @@ impl TriangleBvh {
     /// `any_hit` with the AVX kernels of `closest_hit_avx`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn any_hit_avx<R>(
+    fn any_hit_avx<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
-        to_object: impl Fn(&R) -> (Vec3A, Vec3A),
+        to_object: F,
         t_min: f32,
         t_max: f32,
     ) -> bool {
@@ -390,16 +396,16 @@ impl TriangleBvh {
         let r = SlabRay::new(o, d);
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX, what `by_octant` needs.
-        unsafe { self.by_octant::<true, false>(&r, t_min, t_max) }.is_some()
+        unsafe { self.by_octant::<(R, F), true, false>(&r, t_min, t_max) }.is_some()
     }
 
     /// `any_hit` with the kernels of `closest_hit_avx512`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
-    fn any_hit_avx512<R>(
+    fn any_hit_avx512<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
-        to_object: impl Fn(&R) -> (Vec3A, Vec3A),
+        to_object: F,
         t_min: f32,
         t_max: f32,
     ) -> bool {
@@ -407,7 +413,7 @@ impl TriangleBvh {
         let r = SlabRay::new(o, d);
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
-        unsafe { self.by_octant::<true, true>(&r, t_min, t_max) }.is_some()
+        unsafe { self.by_octant::<(R, F), true, true>(&r, t_min, t_max) }.is_some()
     }
 
     /// The AVX walk (`WIDE`: with the AVX-512 leaf test) for the ray's octant: one copy of
@@ -418,7 +424,8 @@ impl TriangleBvh {
     /// `InOctant`) and +10-11% with AVX (16 vector registers: a copy per octant needs fewer
     /// of them), the editor's Whitted frames even or faster (`docs/perf.md`). Choosing the
     /// rows by blends in one copy gained nothing, so it is not the rows alone.
-    /// `FIRST`: stop at the first hit (`any_hit`).
+    /// `FIRST`: stop at the first hit (`any_hit`). `M`: the caller's ray type and move, so
+    /// each caller's walks get leaf tests of their own (`InOctant`).
     ///
     /// # Safety
     /// The CPU must have AVX, and AVX-512 F and VL when `WIDE`; called only from functions
@@ -426,7 +433,7 @@ impl TriangleBvh {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn by_octant<const FIRST: bool, const WIDE: bool>(
+    unsafe fn by_octant<M, const FIRST: bool, const WIDE: bool>(
         &self,
         r: &SlabRay,
         t_min: f32,
@@ -437,21 +444,29 @@ impl TriangleBvh {
         unsafe {
             match r.toward_neg {
                 [false, false, false] => {
-                    self.walk::<FIRST, WIDE, false, false, false>(r, t_min, t_max)
+                    self.walk::<M, FIRST, WIDE, false, false, false>(r, t_min, t_max)
                 }
                 [false, false, true] => {
-                    self.walk::<FIRST, WIDE, false, false, true>(r, t_min, t_max)
+                    self.walk::<M, FIRST, WIDE, false, false, true>(r, t_min, t_max)
                 }
                 [false, true, false] => {
-                    self.walk::<FIRST, WIDE, false, true, false>(r, t_min, t_max)
+                    self.walk::<M, FIRST, WIDE, false, true, false>(r, t_min, t_max)
                 }
-                [false, true, true] => self.walk::<FIRST, WIDE, false, true, true>(r, t_min, t_max),
+                [false, true, true] => {
+                    self.walk::<M, FIRST, WIDE, false, true, true>(r, t_min, t_max)
+                }
                 [true, false, false] => {
-                    self.walk::<FIRST, WIDE, true, false, false>(r, t_min, t_max)
+                    self.walk::<M, FIRST, WIDE, true, false, false>(r, t_min, t_max)
                 }
-                [true, false, true] => self.walk::<FIRST, WIDE, true, false, true>(r, t_min, t_max),
-                [true, true, false] => self.walk::<FIRST, WIDE, true, true, false>(r, t_min, t_max),
-                [true, true, true] => self.walk::<FIRST, WIDE, true, true, true>(r, t_min, t_max),
+                [true, false, true] => {
+                    self.walk::<M, FIRST, WIDE, true, false, true>(r, t_min, t_max)
+                }
+                [true, true, false] => {
+                    self.walk::<M, FIRST, WIDE, true, true, false>(r, t_min, t_max)
+                }
+                [true, true, true] => {
+                    self.walk::<M, FIRST, WIDE, true, true, true>(r, t_min, t_max)
+                }
             }
         }
     }
@@ -464,6 +479,7 @@ impl TriangleBvh {
     #[inline(always)]
     #[allow(unsafe_code)]
     unsafe fn walk<
+        M,
         const FIRST: bool,
         const WIDE: bool,
         const NX: bool,
@@ -492,7 +508,7 @@ impl TriangleBvh {
                 // leaf test of its own, which LLVM inlines (`avx::leaf8`'s `CALLER`). Not
                 // with AVX: in 16 vector registers the inlined test made the walks 1-3%
                 // slower than one shared copy (`docs/perf.md`).
-                let o = &InOctant::<NX, NY, NZ>(r);
+                let o = &InOctant::<M, NX, NY, NZ>(r, std::marker::PhantomData);
                 #[allow(unsafe_code)]
                 // SAFETY: the caller has AVX, and AVX-512 F and VL when WIDE (the contract).
                 unsafe {
