@@ -11,7 +11,7 @@
 //! - `avx`: the AVX kernels (a ray against eight boxes, against a leaf's eight triangles);
 //!   their `unsafe` is only in `load8`, `store8` and `load_row`.
 //! - `avx512`: the leaf test with AVX-512 mask registers, for the single-ray traversal
-//!   compiled for AVX-512 (`closest_hit_avx512`, `any_hit_avx512`).
+//!   compiled for AVX-512 (`walk_avx512`).
 //! - `packet`: eight coherent rays at once (`closest_hit8`, for `tracelab bench --packets`).
 
 use glam::{Vec3, Vec3A};

@@ -74,7 +74,7 @@ fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray
         // Whichever instruction set `intersect` picked, the portable path must agree.
         assert_eq!(
             a,
-            bvh.closest_hit_portable(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY),
+            bvh.walk_portable::<false>(ray.origin.into(), ray.direction.into(), 0.0, f32::INFINITY),
             "ray {k}"
         );
         // And so must the AVX kernels, which an AVX-512 CPU does not pick by itself.
@@ -83,7 +83,7 @@ fn assert_agrees(pos: &[Vec3], tris: &[[u32; 3]], bvh: &TriangleBvh, rays: &[Ray
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX.
             let avx = unsafe {
-                bvh.closest_hit_avx(
+                bvh.walk_avx::<false, _, _>(
                     ray,
                     |r| (r.origin.into(), r.direction.into()),
                     0.0,
@@ -399,13 +399,13 @@ fn non_finite_rays_miss_and_return() {
             let (o, d) = (Vec3A::from(o), Vec3A::from(d));
             let inf = f32::INFINITY;
             hits += bvh.any_hit(o, d, 0.0, inf) as usize;
-            hits += bvh.closest_hit_portable(o, d, 0.0, inf).is_some() as usize;
-            hits += bvh.any_hit_portable(o, d, 0.0, inf) as usize;
+            hits += bvh.walk_portable::<false>(o, d, 0.0, inf).is_some() as usize;
+            hits += bvh.walk_portable::<true>(o, d, 0.0, inf).is_some() as usize;
             #[cfg(target_arch = "x86_64")]
             if crate::simd::detected() >= crate::simd::Level::Avx {
                 #[allow(unsafe_code)]
                 // SAFETY: the CPU has AVX.
-                let avx = unsafe { bvh.closest_hit_avx(&(o, d), |&r| r, 0.0, inf) };
+                let avx = unsafe { bvh.walk_avx::<false, _, _>(&(o, d), |&r| r, 0.0, inf) };
                 hits += avx.is_some() as usize;
             }
         }
@@ -801,7 +801,7 @@ fn overflowing_triangles_give_the_same_hits_on_every_path() {
         let (o, d) = (ray.origin.into(), ray.direction.into());
         for t_min in [0.0, f32::NEG_INFINITY] {
             let got = bvh.closest_hit(o, d, t_min, f32::INFINITY);
-            let portable = bvh.closest_hit_portable(o, d, t_min, f32::INFINITY);
+            let portable = bvh.walk_portable::<false>(o, d, t_min, f32::INFINITY);
             assert_eq!(got, portable, "ray {k}, t_min {t_min}");
             hits += got.is_some() as usize;
         }
@@ -838,9 +838,9 @@ fn assert_any_hit_agrees(bvh: &TriangleBvh, rays: &[Ray], t_min: f32) -> (usize,
         for (lo, hi) in shadow_ranges(first, t_min) {
             let want = bvh.closest_hit(o, d, lo, hi).is_some();
             assert_eq!(bvh.any_hit(o, d, lo, hi), want, "ray {k} ({lo}, {hi})");
-            let portable = bvh.closest_hit_portable(o, d, lo, hi).is_some();
+            let portable = bvh.walk_portable::<false>(o, d, lo, hi).is_some();
             assert_eq!(
-                bvh.any_hit_portable(o, d, lo, hi),
+                bvh.walk_portable::<true>(o, d, lo, hi).is_some(),
                 portable,
                 "ray {k} ({lo}, {hi}), SSE path"
             );

@@ -167,7 +167,7 @@ pub(super) fn nearest_first<E: StackEntry>(
 
 /// The closest-hit traversal, generic over the 8-box test and the leaf test, and inlined
 /// into the function that picks them so each copy is compiled for the instruction set that
-/// function enables (`closest_hit_portable`, `closest_hit_avx`).
+/// function enables (`walk_portable`, `walk_avx`, `walk_avx512`).
 ///
 /// With `FIRST` it returns at the first leaf hit instead (`any_hit`). Until that hit, t_best
 /// is still t_max, so it takes the very steps the closest-hit walk takes: the same boxes,
@@ -255,83 +255,7 @@ impl TriangleBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<TriangleHit> {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx512() {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU has AVX-512 F and VL, checked just above.
-            return unsafe { self.closest_hit_avx512(ray, to_object, t_min, t_max) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if has_avx() {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU has AVX, checked just above (std caches the answer).
-            return unsafe { self.closest_hit_avx(ray, to_object, t_min, t_max) };
-        }
-        let (o, d) = to_object(ray);
-        self.closest_hit_portable(o, d, t_min, t_max)
-    }
-
-    /// The closest hit with SSE only (any x86-64, and the fallback elsewhere). Not inlined:
-    /// inlined, this traversal (unused where there is AVX) sat in the renderer's hot
-    /// function, and its shape changed the register allocation of that function's hot part.
-    #[inline(never)]
-    pub(super) fn closest_hit_portable(
-        &self,
-        o: Vec3A,
-        d: Vec3A,
-        t_min: f32,
-        t_max: f32,
-    ) -> Option<TriangleHit> {
-        closest_hit_with::<false>(
-            self,
-            &SlabRay::new(o, d),
-            t_min,
-            t_max,
-            SlabRay::slab8,
-            |r, first, count, t_min, t_best| self.leaf_scalar(r, first, count, t_min, t_best),
-        )
-    }
-
-    /// The closest hit with the AVX kernels: the eight slots in one register, a leaf's
-    /// triangles in one test.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    pub(super) fn closest_hit_avx<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
-        &self,
-        ray: &R,
-        to_object: F,
-        t_min: f32,
-        t_max: f32,
-    ) -> Option<TriangleHit> {
-        let (o, d) = to_object(ray);
-        let r = SlabRay::new(o, d);
-        #[allow(unsafe_code)]
-        // SAFETY: this function enables AVX, what `by_octant` needs.
-        unsafe {
-            self.by_octant::<(R, F), false, false>(&r, t_min, t_max)
-        }
-    }
-
-    /// The closest hit with AVX-512 (F and VL): `closest_hit_avx`'s walk and 8-box test
-    /// compiled for AVX-512 (32 vector registers, compares into mask registers), and the leaf
-    /// test with mask registers (`avx512::leaf8`). Both give `closest_hit_avx`'s bits; 3-4%
-    /// faster than it on the bunnies (`docs/perf.md`).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512vl")]
-    pub(super) fn closest_hit_avx512<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
-        &self,
-        ray: &R,
-        to_object: F,
-        t_min: f32,
-        t_max: f32,
-    ) -> Option<TriangleHit> {
-        let (o, d) = to_object(ray);
-        let r = SlabRay::new(o, d);
-        #[allow(unsafe_code)]
-        // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
-        unsafe {
-            self.by_octant::<(R, F), false, true>(&r, t_min, t_max)
-        }
+        self.hit_of::<false, R>(ray, to_object, t_min, t_max)
     }
 
     /// Whether any triangle is hit with t in (t_min, t_max): a shadow ray's question. It
@@ -352,26 +276,48 @@ impl TriangleBvh {
         t_min: f32,
         t_max: f32,
     ) -> bool {
+        self.hit_of::<true, R>(ray, to_object, t_min, t_max)
+            .is_some()
+    }
+
+    /// `closest_hit_of`, or with `FIRST` the first hit found (`any_hit_of`), on the widest
+    /// instruction set this CPU has and `TRACELAB_SIMD` allows (`crate::simd`).
+    #[inline(always)]
+    fn hit_of<const FIRST: bool, R>(
+        &self,
+        ray: &R,
+        to_object: impl Fn(&R) -> (Vec3A, Vec3A),
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
         #[cfg(target_arch = "x86_64")]
         if has_avx512() {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX-512 F and VL, checked just above.
-            return unsafe { self.any_hit_avx512(ray, to_object, t_min, t_max) };
+            return unsafe { self.walk_avx512::<FIRST, R, _>(ray, to_object, t_min, t_max) };
         }
         #[cfg(target_arch = "x86_64")]
         if has_avx() {
             #[allow(unsafe_code)]
             // SAFETY: the CPU has AVX, checked just above (std caches the answer).
-            return unsafe { self.any_hit_avx(ray, to_object, t_min, t_max) };
+            return unsafe { self.walk_avx::<FIRST, R, _>(ray, to_object, t_min, t_max) };
         }
         let (o, d) = to_object(ray);
-        self.any_hit_portable(o, d, t_min, t_max)
+        self.walk_portable::<FIRST>(o, d, t_min, t_max)
     }
 
-    /// `any_hit` with SSE only; not inlined, as `closest_hit_portable`.
+    /// `hit_of`'s walk with SSE only (any x86-64, and the fallback elsewhere). Not inlined:
+    /// inlined, this traversal (unused where there is AVX) sat in the renderer's hot
+    /// function, and its shape changed the register allocation of that function's hot part.
     #[inline(never)]
-    pub(super) fn any_hit_portable(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        closest_hit_with::<true>(
+    pub(super) fn walk_portable<const FIRST: bool>(
+        &self,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        closest_hit_with::<FIRST>(
             self,
             &SlabRay::new(o, d),
             t_min,
@@ -379,41 +325,48 @@ impl TriangleBvh {
             SlabRay::slab8,
             |r, first, count, t_min, t_best| self.leaf_scalar(r, first, count, t_min, t_best),
         )
-        .is_some()
     }
 
-    /// `any_hit` with the AVX kernels of `closest_hit_avx`.
+    /// `hit_of`'s walk with the AVX kernels: the eight slots in one register, a leaf's
+    /// triangles in one test.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn any_hit_avx<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
+    pub(super) fn walk_avx<const FIRST: bool, R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
         to_object: F,
         t_min: f32,
         t_max: f32,
-    ) -> bool {
+    ) -> Option<TriangleHit> {
         let (o, d) = to_object(ray);
         let r = SlabRay::new(o, d);
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX, what `by_octant` needs.
-        unsafe { self.by_octant::<(R, F), true, false>(&r, t_min, t_max) }.is_some()
+        unsafe {
+            self.by_octant::<(R, F), FIRST, false>(&r, t_min, t_max)
+        }
     }
 
-    /// `any_hit` with the kernels of `closest_hit_avx512`.
+    /// `hit_of`'s walk with AVX-512 (F and VL): `walk_avx`'s walk and 8-box test compiled for
+    /// AVX-512 (32 vector registers, compares into mask registers), and the leaf test with
+    /// mask registers (`avx512::leaf8`). Both give `walk_avx`'s bits; 3-4% faster than it on
+    /// the bunnies (`docs/perf.md`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
-    fn any_hit_avx512<R, F: Fn(&R) -> (Vec3A, Vec3A)>(
+    fn walk_avx512<const FIRST: bool, R, F: Fn(&R) -> (Vec3A, Vec3A)>(
         &self,
         ray: &R,
         to_object: F,
         t_min: f32,
         t_max: f32,
-    ) -> bool {
+    ) -> Option<TriangleHit> {
         let (o, d) = to_object(ray);
         let r = SlabRay::new(o, d);
         #[allow(unsafe_code)]
         // SAFETY: this function enables AVX-512 F and VL, what `by_octant` needs.
-        unsafe { self.by_octant::<(R, F), true, true>(&r, t_min, t_max) }.is_some()
+        unsafe {
+            self.by_octant::<(R, F), FIRST, true>(&r, t_min, t_max)
+        }
     }
 
     /// The AVX walk (`WIDE`: with the AVX-512 leaf test) for the ray's octant: one copy of
